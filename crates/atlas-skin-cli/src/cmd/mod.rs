@@ -1,0 +1,10 @@
+//! One module per subcommand, each with its `Args` and `run`.
+
+pub mod animate;
+pub mod bench;
+pub mod demo;
+pub mod eval;
+pub mod inspect;
+pub mod pose;
+pub mod report;
+pub mod skin;

@@ -1,0 +1,57 @@
+//! `atlas-skin`: automatic character skinning from the command line.
+
+mod cmd;
+mod input;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// Skins a character automatically: cuts the mesh into regions at the joints, overlaps them
+/// along the surface, turns the overlaps into smooth weights and writes a skinned glTF.
+#[derive(Parser)]
+#[command(name = "atlas-skin", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Print what was read from a character: mesh facts, the joint tree, warnings.
+    Inspect(cmd::inspect::Args),
+    /// Compute skinning weights and write a skinned glTF binary (the main job).
+    Skin(cmd::skin::Args),
+    /// Write the project's own demo character (a closed humanoid with its skeleton).
+    Demo(cmd::demo::Args),
+    /// Pose a skinned character and write the deformed mesh.
+    Pose(cmd::pose::Args),
+    /// Put a BVH motion on a skinned character as a glTF animation.
+    Animate(cmd::animate::Args),
+    /// Time linear blend and dual quaternion skinning on this machine.
+    Bench(cmd::bench::Args),
+    /// Compare candidate weights with reference (artist) weights.
+    Eval(cmd::eval::Args),
+    /// Write a self-contained HTML report with an interactive 3D view.
+    Report(cmd::report::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Inspect(args) => cmd::inspect::run(args),
+        Command::Skin(args) => cmd::skin::run(args),
+        Command::Demo(args) => cmd::demo::run(args),
+        Command::Pose(args) => cmd::pose::run(args),
+        Command::Animate(args) => cmd::animate::run(args),
+        Command::Bench(args) => cmd::bench::run(args),
+        Command::Eval(args) => cmd::eval::run(args),
+        Command::Report(args) => cmd::report::run(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("error: {error:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

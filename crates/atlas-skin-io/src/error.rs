@@ -1,0 +1,65 @@
+//! The file formats' error type: every variant names the file and what is wrong with it.
+
+use atlas_skin_runtime::RuntimeError;
+use std::path::PathBuf;
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum IoError {
+    #[error("{}: cannot read: {source}", path.display())]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: cannot write: {source}", path.display())]
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: is a directory, not a file", path.display())]
+    IsDirectory { path: PathBuf },
+    #[error("{}: the file is empty", path.display())]
+    Empty { path: PathBuf },
+    #[error("{}: unsupported file type {extension:?} (expected {expected})", path.display())]
+    UnsupportedFormat {
+        path: PathBuf,
+        extension: String,
+        expected: &'static str,
+    },
+    /// A problem at a known line of a text file (1-based).
+    #[error("{}:{line}: {message}", path.display())]
+    Syntax {
+        path: PathBuf,
+        line: usize,
+        message: String,
+    },
+    /// A problem with the content of a file that is not tied to one line.
+    #[error("{}: {message}", path.display())]
+    Invalid { path: PathBuf, message: String },
+    #[error("{}: invalid skeleton: {source}", path.display())]
+    Skeleton {
+        path: PathBuf,
+        source: RuntimeError,
+    },
+    #[error("{}: refusing to write over the input file", path.display())]
+    WouldOverwriteInput { path: PathBuf },
+}
+
+impl IoError {
+    /// Shorthand for [`IoError::Invalid`].
+    pub fn invalid(path: impl Into<PathBuf>, message: impl Into<String>) -> Self {
+        Self::Invalid {
+            path: path.into(),
+            message: message.into(),
+        }
+    }
+
+    /// Shorthand for [`IoError::Syntax`].
+    pub fn syntax(path: impl Into<PathBuf>, line: usize, message: impl Into<String>) -> Self {
+        Self::Syntax {
+            path: path.into(),
+            line,
+            message: message.into(),
+        }
+    }
+}

@@ -1,0 +1,93 @@
+//! The result of the decomposition stages (§3.1 cuts, §3.2 regions): what the weights stage
+//! (§3.3–§5) reads. Plain data; [`crate::decompose`] builds it.
+
+use crate::{SurfaceMesh, Topology};
+use glam::DVec3;
+use serde::Serialize;
+
+/// The surface split along the cut curves, its regions and the boundaries between them.
+#[derive(Debug, Clone)]
+pub struct Decomposition {
+    /// The welded surface with every cut curve inserted as a chain of edges. Vertices
+    /// `0..welded_vertex_count` are the welded mesh's, unchanged and in order; the vertices
+    /// after them lie on cut curves.
+    pub surface: SurfaceMesh,
+    /// Topology of `surface`.
+    pub topology: Topology,
+    /// Number of welded-mesh vertices at the start of `surface.positions`.
+    pub welded_vertex_count: usize,
+    /// #F(surface): region index of every face.
+    pub face_region: Vec<u32>,
+    pub regions: Vec<Region>,
+    pub boundaries: Vec<Boundary>,
+    /// One decision per skeleton joint, in skeleton order.
+    pub joints: Vec<JointDecision>,
+}
+
+/// A connected part of the split surface.
+#[derive(Debug, Clone, Serialize)]
+pub struct Region {
+    /// Joints that move this region, ordered along the chain from the root side; the first
+    /// is the joint the region is bound to. Empty when no joint reaches the region (a loose
+    /// piece): the weights stage then takes weights from the nearest weighted surface.
+    pub joints: Vec<u32>,
+    pub faces: usize,
+    pub vertices: usize,
+}
+
+/// How a boundary separates its two sides.
+#[derive(Debug, Clone, PartialEq)]
+pub enum BoundaryKind {
+    /// An exact closed cut curve (§3.1): a loop of `surface` vertex indices, consecutive
+    /// ones joined by an edge of `surface`. It separates `parent_region` from `child_region`.
+    Cut { curve: Vec<u32> },
+    /// No closed, conflict-free cut exists: the joint's plane restricted to the region that
+    /// holds it stands in for the curve, and the signed distance to the plane for the
+    /// surface distance (METHOD.md, "extensions"). `parent_region == child_region`.
+    Soft,
+}
+
+/// The boundary of one joint.
+#[derive(Debug, Clone)]
+pub struct Boundary {
+    /// The skeleton joint at which the surface is cut.
+    pub joint: u32,
+    pub kind: BoundaryKind,
+    /// A point of the cutting plane (the joint's bind position).
+    pub point: DVec3,
+    /// Unit plane normal, pointing to the child side: n · (upper + lower) > 0.
+    pub normal: DVec3,
+    /// Length of the closed curve (for a soft boundary, of the plane's section estimate).
+    pub perimeter: f64,
+    /// Approximate diameter D of the curve: the largest distance between two curve points.
+    pub diameter: f64,
+    /// Region on the parent bone's side.
+    pub parent_region: u32,
+    /// Region on the child bone's side.
+    pub child_region: u32,
+}
+
+/// Why a joint has the boundary it has, for the report.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case", tag = "status", content = "reason")]
+pub enum JointStatus {
+    /// An exact closed cut: index into [`Decomposition::boundaries`] in `boundary`.
+    Cut,
+    /// A soft boundary, with why no cut was placed.
+    Soft(String),
+    /// No boundary, with why (branching joint on the symmetry axis, end site, outside the
+    /// mesh and owning no geometry, forbidden by the user, ...).
+    Skipped(String),
+}
+
+/// The decision for one joint.
+#[derive(Debug, Clone, Serialize)]
+pub struct JointDecision {
+    pub name: String,
+    #[serde(flatten)]
+    pub status: JointStatus,
+    /// Index into [`Decomposition::boundaries`] when the joint has a boundary.
+    pub boundary: Option<u32>,
+    /// The region the joint's bone lies in.
+    pub region: Option<u32>,
+}

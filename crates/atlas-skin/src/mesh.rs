@@ -1,0 +1,64 @@
+//! The surface the algorithms work on.
+
+use glam::DVec3;
+
+/// A triangle surface in double precision, after welding.
+///
+/// - `positions`: #V vertex positions.
+/// - `triangles`: #F vertex index triples, all in range; a triangle may be degenerate
+///   (repeated index or zero area) when the input had such faces.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SurfaceMesh {
+    pub positions: Vec<DVec3>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl SurfaceMesh {
+    /// Number of vertices.
+    pub fn vertex_count(&self) -> usize {
+        self.positions.len()
+    }
+
+    /// Number of triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// Axis-aligned bounding box `(min, max)`; `(0, 0)` for an empty mesh.
+    pub fn bounding_box(&self) -> (DVec3, DVec3) {
+        bounding_box(&self.positions)
+    }
+
+    /// Length of the bounding box diagonal.
+    pub fn diagonal(&self) -> f64 {
+        let (lo, hi) = self.bounding_box();
+        (hi - lo).length()
+    }
+
+    /// The three corner positions of triangle `f`.
+    pub fn corners(&self, f: usize) -> [DVec3; 3] {
+        self.triangles[f].map(|v| self.positions[v as usize])
+    }
+
+    /// Area-weighted normal of triangle `f`: `(b − a) × (c − a)`, of length twice its area.
+    pub fn scaled_normal(&self, f: usize) -> DVec3 {
+        let [a, b, c] = self.corners(f);
+        (b - a).cross(c - a)
+    }
+
+    /// Area of triangle `f`.
+    pub fn triangle_area(&self, f: usize) -> f64 {
+        0.5 * self.scaled_normal(f).length()
+    }
+}
+
+/// Axis-aligned bounding box of points, `(0, 0)` when there are none.
+pub fn bounding_box(points: &[DVec3]) -> (DVec3, DVec3) {
+    if points.is_empty() {
+        return (DVec3::ZERO, DVec3::ZERO);
+    }
+    points.iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    )
+}
