@@ -5,12 +5,15 @@
 //! palette with per-vertex [`VertexWeights`] deforms the rest mesh by linear blend skinning
 //! or dual quaternion skinning (Kavan et al. 2007).
 
+pub mod animation;
 pub mod error;
 pub mod pose;
+pub mod random_pose;
 pub mod reference;
 pub mod skeleton;
 pub mod weights;
 
+pub use animation::{Clip, Interpolation, Property, Rig, Track, Trs};
 pub use error::RuntimeError;
 pub use skeleton::{Skeleton, NO_PARENT};
 pub use weights::VertexWeights;
