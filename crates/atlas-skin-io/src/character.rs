@@ -1,6 +1,6 @@
 //! What every reader produces.
 
-use atlas_skin_runtime::{Skeleton, VertexWeights};
+use atlas_skin_runtime::{Clip, Rig, Skeleton, VertexWeights};
 use glam::Vec3;
 use std::path::PathBuf;
 
@@ -27,6 +27,10 @@ pub struct Character {
     /// Weights that came with the input (artist or precomputed), per stored vertex, joint
     /// indices into `skeleton`. Rows are as stored: they may not sum to 1.
     pub reference_weights: Option<VertexWeights>,
+    /// The node hierarchy animations drive (glTF nodes, or the joints of a skeleton file).
+    pub rig: Option<Rig>,
+    /// Animations in the input, tracks on `rig`'s nodes.
+    pub clips: Vec<Clip>,
     /// Warnings about quirks of the input that were handled.
     pub warnings: Vec<String>,
 }
@@ -50,6 +54,8 @@ impl Character {
             mesh,
             skeleton: None,
             reference_weights: None,
+            rig: None,
+            clips: Vec::new(),
             warnings: Vec::new(),
         }
     }
