@@ -2,15 +2,15 @@
 
 use anyhow::{Context, Result};
 use atlas_skin::{weld, MeshStats, Topology, Welded};
-use atlas_skin_io::{Character, LoadOptions};
+use atlas_skin_io::{Character, LoadOptions, TriangleMesh};
 use std::path::PathBuf;
 
 /// Where the character comes from.
 #[derive(clap::Args, Debug, Clone)]
 pub struct InputArgs {
     /// The character: .glb/.gltf/.vrm (mesh and skeleton), or a mesh (.obj, .mesh, .off,
-    /// .ply, .stl) with --skeleton.
-    pub input: PathBuf,
+    /// .ply, .stl) with --skeleton. Without it: the built-in demo character.
+    pub input: Option<PathBuf>,
     /// Skeleton file for a mesh without one: .tgf, .bvh, .mhskel or .json.
     #[arg(long)]
     pub skeleton: Option<PathBuf>,
@@ -31,11 +31,29 @@ impl InputArgs {
         }
     }
 
-    /// Reads the character.
+    /// Reads the character, or builds the demo character when no input is given.
     pub fn load(&self) -> Result<Character> {
-        atlas_skin_io::load_character(&self.input, &self.load_options())
-            .with_context(|| format!("cannot load {}", self.input.display()))
+        match &self.input {
+            Some(path) => atlas_skin_io::load_character(path, &self.load_options())
+                .with_context(|| format!("cannot load {}", path.display())),
+            None => Ok(demo_character()),
+        }
     }
+}
+
+/// The built-in demo character ([`atlas_skin::demo`]) as if read from a file named
+/// `demo`: mesh and skeleton, no weights.
+pub fn demo_character() -> Character {
+    let demo = atlas_skin::demo::demo_character(atlas_skin::demo::DEFAULT_STEP);
+    let mut character = Character::new(
+        "demo",
+        TriangleMesh {
+            positions: demo.positions,
+            triangles: demo.triangles,
+        },
+    );
+    character.skeleton = Some(demo.skeleton);
+    character
 }
 
 /// A character with its welded surface and topology, ready for the method.

@@ -1,6 +1,7 @@
 //! `atlas-skin`: automatic character skinning from the command line.
 
 mod cmd;
+mod html;
 mod input;
 
 use clap::{Parser, Subcommand};

@@ -14,6 +14,38 @@ pub struct TriangleMesh {
     pub triangles: Vec<[u32; 3]>,
 }
 
+impl TriangleMesh {
+    /// The mesh without the vertices no triangle uses, in file order, and the file index of
+    /// every kept vertex (#kept).
+    pub fn without_unused_vertices(&self) -> (TriangleMesh, Vec<u32>) {
+        let mut used = vec![false; self.positions.len()];
+        for t in &self.triangles {
+            for &v in t {
+                used[v as usize] = true;
+            }
+        }
+        let file_vertex: Vec<u32> = (0..self.positions.len() as u32)
+            .filter(|&v| used[v as usize])
+            .collect();
+        let mut kept_of_file = vec![u32::MAX; self.positions.len()];
+        for (kept, &v) in file_vertex.iter().enumerate() {
+            kept_of_file[v as usize] = kept as u32;
+        }
+        let mesh = TriangleMesh {
+            positions: file_vertex
+                .iter()
+                .map(|&v| self.positions[v as usize])
+                .collect(),
+            triangles: self
+                .triangles
+                .iter()
+                .map(|t| t.map(|v| kept_of_file[v as usize]))
+                .collect(),
+        };
+        (mesh, file_vertex)
+    }
+}
+
 /// A character read from disk.
 #[derive(Debug, Clone)]
 pub struct Character {
@@ -33,6 +65,13 @@ pub struct Character {
     pub clips: Vec<Clip>,
     /// Warnings about quirks of the input that were handled.
     pub warnings: Vec<String>,
+    /// #V: index of each mesh vertex in the file's own vertex list. For OBJ, MEDIT, OFF,
+    /// PLY and STL the loader drops vertices no kept triangle uses; this maps back, e.g. for
+    /// MakeHuman files that index base.obj's full vertex list. Identity for glTF.
+    pub file_vertex: Vec<u32>,
+    /// For glTF input: the source document, its buffers and where each primitive went in
+    /// `mesh` (what the glTF writer needs to preserve the document).
+    pub gltf: Option<crate::gltf::GltfSource>,
 }
 
 /// How to read an input.
@@ -49,6 +88,7 @@ pub struct LoadOptions {
 impl Character {
     /// A character with a mesh and nothing else; readers fill in the rest.
     pub fn new(path: impl Into<PathBuf>, mesh: TriangleMesh) -> Self {
+        let file_vertex = (0..mesh.positions.len() as u32).collect();
         Self {
             path: path.into(),
             mesh,
@@ -57,6 +97,8 @@ impl Character {
             rig: None,
             clips: Vec::new(),
             warnings: Vec::new(),
+            file_vertex,
+            gltf: None,
         }
     }
 }

@@ -7,9 +7,22 @@
 //!
 //! Units and axes stay as in the file.
 
+pub mod bvh;
 pub mod character;
+pub mod dmat;
 pub mod error;
+pub mod gltf;
 pub mod load;
+pub mod medit;
+pub mod mhskel;
+pub mod mhw;
+pub mod obj;
+pub mod off;
+pub mod ply;
+pub mod skeleton_json;
+pub mod stl;
+mod text;
+pub mod tgf;
 
 pub use character::{Character, LoadOptions, TriangleMesh};
 pub use error::IoError;

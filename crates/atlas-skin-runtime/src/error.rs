@@ -7,7 +7,11 @@ use thiserror::Error;
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum RuntimeError {
     #[error("joint {joint} has parent index {parent}, but the skeleton has {count} joints")]
-    ParentOutOfRange { joint: usize, parent: u32, count: usize },
+    ParentOutOfRange {
+        joint: usize,
+        parent: u32,
+        count: usize,
+    },
     #[error("the joint hierarchy has a cycle through joint {joint} ({name:?})")]
     Cycle { joint: usize, name: String },
     #[error("skeleton arrays disagree in length: {what}")]
@@ -15,11 +19,39 @@ pub enum RuntimeError {
     #[error("joint {joint} ({name:?}) has a non-finite or singular bind matrix")]
     BadBindMatrix { joint: usize, name: String },
     #[error("vertex {vertex} refers to joint {joint}, but the skeleton has {count} joints")]
-    JointOutOfRange { vertex: usize, joint: u32, count: usize },
+    JointOutOfRange {
+        vertex: usize,
+        joint: u32,
+        count: usize,
+    },
     #[error("vertex {vertex} has weight {weight} (weights must be finite and >= 0)")]
     BadWeight { vertex: usize, weight: f32 },
     #[error("buffer sizes disagree: {what}")]
     BufferSize { what: String },
-    #[error("joint {joint} ({name:?}) has scale {scale} in its skinning matrix; dual quaternion skinning needs rigid transforms")]
-    NonRigid { joint: usize, name: String, scale: f32 },
+    #[error("palette matrix {joint} has scale {scale} (or shear, or a projective row); dual quaternion skinning needs rigid transforms")]
+    NonRigid { joint: usize, scale: f32 },
+    #[error("palette matrix {joint} is not finite")]
+    NonFinitePalette { joint: usize },
+    #[error("rig node {node} ({name:?}): {what}")]
+    BadRig {
+        node: usize,
+        name: String,
+        what: String,
+    },
+    #[error("animation {clip:?}, track {track} (node {node}): {what}")]
+    BadTrack {
+        clip: String,
+        track: usize,
+        node: u32,
+        what: String,
+    },
+    #[error("vertex {vertex} has no influence with a positive weight")]
+    UnweightedVertex { vertex: usize },
+    #[error("the skeleton has {count} joints; compact skins index at most 65536")]
+    TooManyJoints { count: usize },
+    #[error("no joint name in common between the motion (joints like {source_joint:?}) and the character (joints like {target_joint:?})")]
+    NoCommonJoints {
+        source_joint: String,
+        target_joint: String,
+    },
 }

@@ -6,14 +6,27 @@
 //! or dual quaternion skinning (Kavan et al. 2007).
 
 pub mod animation;
+pub mod compact_skin;
+pub mod dual_quaternion;
 pub mod error;
 pub mod pose;
 pub mod random_pose;
 pub mod reference;
+pub mod retarget;
+pub mod rig;
+pub mod sampling;
 pub mod skeleton;
+#[cfg(target_arch = "x86_64")]
+mod skinning_avx2;
+pub mod skinning_job;
+pub mod skinning_palette;
 pub mod weights;
 
 pub use animation::{Clip, Interpolation, Property, Rig, Track, Trs};
+pub use compact_skin::CompactSkin;
+pub use dual_quaternion::DualQuat;
 pub use error::RuntimeError;
 pub use skeleton::{Skeleton, NO_PARENT};
+pub use skinning_job::{SkinningJob, Threading};
+pub use skinning_palette::{SkinningMethod, SkinningPalette};
 pub use weights::VertexWeights;

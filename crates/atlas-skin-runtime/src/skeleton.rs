@@ -205,7 +205,11 @@ mod tests {
             (names(), vec![NO_PARENT, 7], ibm()),
             (names(), vec![1, 0], ibm()),
             (names(), vec![NO_PARENT, 1], ibm()),
-            (names(), vec![NO_PARENT, 0], vec![Mat4::IDENTITY, Mat4::ZERO]),
+            (
+                names(),
+                vec![NO_PARENT, 0],
+                vec![Mat4::IDENTITY, Mat4::ZERO],
+            ),
             (
                 names(),
                 vec![NO_PARENT, 0],

@@ -1,9 +1,180 @@
-//! Placeholder: filled in by its issue.
+//! `atlas-skin animate`: put a BVH motion on a skinned character, as a glTF animation on
+//! its skeleton (any glTF viewer plays it) or as a sequence of posed OBJ meshes.
+//!
+//! Every BVH frame is retargeted onto the character's rig by joint names
+//! ([`atlas_skin_runtime::retarget`]); the animation has one LINEAR rotation track per
+//! matched joint and a translation track for the joint matched to the motion's root.
+
+use super::pose::{write_mesh, BvhMotion, Posable};
+use crate::input::InputArgs;
+use anyhow::{Context, Result};
+use atlas_skin_io::gltf::{write_skinned_glb, WriteOptions};
+use atlas_skin_io::Character;
+use atlas_skin_runtime::retarget::Retarget;
+use atlas_skin_runtime::{Clip, Interpolation, Property, SkinningMethod, Track, Trs};
+use std::path::{Path, PathBuf};
 
 /// Arguments.
 #[derive(clap::Args)]
-pub struct Args {}
+pub struct Args {
+    #[command(flatten)]
+    pub input: InputArgs,
+    /// The motion: a BVH file whose joint names match the character's.
+    #[arg(long)]
+    pub bvh: PathBuf,
+    /// Dual quaternion skinning for an OBJ sequence (a glb is skinned by its viewer).
+    #[arg(long)]
+    pub dqs: bool,
+    /// Output: OUT.glb (the character with the animation), or OUT.obj for one posed mesh
+    /// per frame, OUT_0001.obj, OUT_0002.obj, ...
+    #[arg(short = 'o', long)]
+    pub output: PathBuf,
+}
 
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("not implemented yet")
+pub fn run(args: Args) -> Result<()> {
+    let character = args.input.load()?;
+    let motion = BvhMotion::read(&args.bvh)?;
+    let is_obj = args
+        .output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+    if is_obj {
+        let method = if args.dqs {
+            SkinningMethod::DualQuaternion
+        } else {
+            SkinningMethod::LinearBlend
+        };
+        write_obj_sequence(&character, &motion, method, &args.output)
+    } else {
+        let (weights, options) = animation_options(&character, &motion)?;
+        write_skinned_glb(&character, weights, &options, &args.output)
+            .with_context(|| format!("cannot write {}", args.output.display()))
+    }
+}
+
+/// The character at `input` with the BVH motion at `bvh` as a glTF animation, as the
+/// bytes of a `.glb` (for the HTML report).
+pub fn animate_glb_bytes(input: &Path, bvh: &Path) -> Result<Vec<u8>> {
+    let character = atlas_skin_io::load_character(input, &Default::default())
+        .with_context(|| format!("cannot load {}", input.display()))?;
+    let motion = BvhMotion::read(bvh)?;
+    let (weights, options) = animation_options(&character, &motion)?;
+    // The writer writes files; a private temporary file turns it into bytes.
+    let temporary = std::env::temp_dir().join(format!(
+        "atlas-skin-animate-{}-{}.glb",
+        std::process::id(),
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos())
+    ));
+    write_skinned_glb(&character, weights, &options, &temporary)
+        .context("cannot write the animated glb")?;
+    let bytes = std::fs::read(&temporary).context("cannot read back the animated glb");
+    // Best effort: a leftover file in the temporary directory is harmless.
+    let _ = std::fs::remove_file(&temporary);
+    bytes
+}
+
+/// The weights to write and the writer options carrying the retargeted animation.
+fn animation_options<'a>(
+    character: &'a Character,
+    motion: &BvhMotion,
+) -> Result<(&'a atlas_skin_runtime::VertexWeights, WriteOptions)> {
+    let posable = Posable::new(character)?;
+    let clip = retargeted_clip(&posable, motion)?;
+    let weights = character
+        .reference_weights
+        .as_ref()
+        .context("the character has no skin weights")?;
+    Ok((
+        weights,
+        WriteOptions {
+            animations: vec![clip],
+            ..WriteOptions::default()
+        },
+    ))
+}
+
+/// The motion as a clip on the character's skeleton (`Track::node` = joint index): a
+/// rotation track per joint whose local rotation changes, a translation track per joint
+/// whose local translation changes, one LINEAR key per BVH frame.
+pub fn retargeted_clip(posable: &Posable, motion: &BvhMotion) -> Result<Clip> {
+    let rig = &posable.rig;
+    let mut retarget =
+        Retarget::new(&motion.rig, rig).context("cannot map the motion onto the character")?;
+    let times = motion.frame_times().to_vec();
+    let mut frames: Vec<Vec<Trs>> = Vec::with_capacity(times.len());
+    let mut local = rig.rest.clone();
+    for &time in &times {
+        retarget.apply(&motion.rig, &motion.sample(time), rig, &mut local);
+        frames.push(local.clone());
+    }
+    let mut tracks = Vec::new();
+    for (joint, &node) in rig.joint_nodes.iter().enumerate() {
+        let node = node as usize;
+        let rest = rig.rest[node];
+        let rotations = frames.iter().map(|f| f[node].rotation.to_array());
+        if frames.iter().any(|f| f[node].rotation != rest.rotation) {
+            tracks.push(track(
+                joint,
+                Property::Rotation,
+                &times,
+                rotations.flatten(),
+            ));
+        }
+        if frames
+            .iter()
+            .any(|f| f[node].translation != rest.translation)
+        {
+            let translations = frames.iter().map(|f| f[node].translation.to_array());
+            tracks.push(track(
+                joint,
+                Property::Translation,
+                &times,
+                translations.flatten(),
+            ));
+        }
+    }
+    Ok(Clip {
+        name: motion.clip.name.clone(),
+        duration: times.last().copied().unwrap_or(0.0),
+        tracks,
+    })
+}
+
+fn track(
+    joint: usize,
+    property: Property,
+    times: &[f32],
+    values: impl Iterator<Item = f32>,
+) -> Track {
+    Track {
+        node: joint as u32,
+        property,
+        interpolation: Interpolation::Linear,
+        times: times.to_vec(),
+        values: values.collect(),
+    }
+}
+
+/// One posed OBJ per frame: `out` with `_0001`, `_0002`, … before the extension.
+fn write_obj_sequence(
+    character: &Character,
+    motion: &BvhMotion,
+    method: SkinningMethod,
+    out: &Path,
+) -> Result<()> {
+    let posable = Posable::new(character)?;
+    let rig = &posable.rig;
+    let mut retarget =
+        Retarget::new(&motion.rig, rig).context("cannot map the motion onto the character")?;
+    let stem = out.with_extension("");
+    let mut local = rig.rest.clone();
+    for (frame, &time) in motion.frame_times().iter().enumerate() {
+        retarget.apply(&motion.rig, &motion.sample(time), rig, &mut local);
+        let posed = posable.deform(&local, method)?;
+        let path = PathBuf::from(format!("{}_{:04}.obj", stem.display(), frame + 1));
+        write_mesh(&posed, &character.mesh.triangles, &path)?;
+    }
+    Ok(())
 }

@@ -1,9 +1,166 @@
-//! Placeholder: filled in by its issue.
+//! `atlas-skin eval`: compares candidate weights with reference (artist) weights on the same
+//! mesh: weight difference, deformation error, bleeding, validity
+//! ([`atlas_skin::eval`]).
+
+use crate::input::{InputArgs, Prepared};
+use anyhow::{Context, Result};
+use atlas_skin::eval::{evaluate, Animation, EvalInput, EvalOptions, Evaluation, Weighted};
+use atlas_skin_io::{Character, LoadOptions};
+use std::path::PathBuf;
 
 /// Arguments.
-#[derive(clap::Args)]
-pub struct Args {}
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// The reference character with its weights: .glb/.gltf/.vrm, or a mesh with
+    /// --skeleton and --weights.
+    pub reference: PathBuf,
+    /// The candidate: a skinned .glb/.gltf of the same mesh, joints named as the
+    /// reference's.
+    pub candidate: PathBuf,
+    /// Skeleton file for a reference mesh without one: .tgf, .bvh, .mhskel or .json.
+    #[arg(long)]
+    pub skeleton: Option<PathBuf>,
+    /// Use only the faces of this OBJ group of the reference (e.g. MakeHuman's `body`).
+    #[arg(long)]
+    pub group: Option<String>,
+    /// Reference weights for a mesh without them: .dmat (libigl) or .mhw (MakeHuman).
+    #[arg(long)]
+    pub weights: Option<PathBuf>,
+    /// Number of seeded random poses.
+    #[arg(long, default_value_t = 10)]
+    pub poses: usize,
+    /// Seed of the first random pose (pose i uses seed + i).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Number of frames of the reference's first animation (0 skips the animation figures).
+    #[arg(long, default_value_t = 8)]
+    pub anim_frames: usize,
+    /// Keep only the N largest reference weights per vertex before renormalising
+    /// (BASELINES.md does so with 4 for MakeHuman).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+    pub prune_reference: Option<u16>,
+    /// Print the figures as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
 
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("not implemented yet")
+pub fn run(args: Args) -> Result<()> {
+    let reference_input = InputArgs {
+        input: Some(args.reference.clone()),
+        skeleton: args.skeleton.clone(),
+        group: args.group.clone(),
+        weights: args.weights.clone(),
+    };
+    let reference = Prepared::new(reference_input.load()?);
+    let candidate = atlas_skin_io::load_character(&args.candidate, &LoadOptions::default())
+        .with_context(|| format!("cannot load {}", args.candidate.display()))?;
+    let options = EvalOptions {
+        poses: args.poses,
+        seed: args.seed,
+        anim_frames: args.anim_frames,
+        reference_max_influences: args.prune_reference.map(usize::from),
+        ..EvalOptions::default()
+    };
+    let evaluation = compare(&reference, &candidate, &options)?;
+    if evaluation.matched < evaluation.vertices {
+        eprintln!(
+            "warning: {} of {} reference vertices have no candidate vertex at their position; \
+             the figures cover the {} matched",
+            evaluation.vertices - evaluation.matched,
+            evaluation.vertices,
+            evaluation.matched
+        );
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&evaluation)?);
+    } else {
+        print!("{}", summary(&evaluation));
+    }
+    Ok(())
+}
+
+/// Evaluates `candidate`'s weights against `reference`'s.
+fn compare(
+    reference: &Prepared,
+    candidate: &Character,
+    options: &EvalOptions,
+) -> Result<Evaluation> {
+    let character = &reference.character;
+    let input = EvalInput {
+        reference: weighted(character, "reference")?,
+        surface: &reference.welded,
+        topology: &reference.topology,
+        candidate: weighted(candidate, "candidate")?,
+        animation: character
+            .rig
+            .as_ref()
+            .zip(character.clips.first())
+            .filter(|_| options.anim_frames > 0)
+            .map(|(rig, clip)| Animation { rig, clip }),
+    };
+    evaluate(&input, options).with_context(|| {
+        format!(
+            "cannot compare {} with {}",
+            candidate.path.display(),
+            character.path.display()
+        )
+    })
+}
+
+/// The mesh, skeleton and weights of `character`, which must have the last two.
+fn weighted<'a>(character: &'a Character, role: &str) -> Result<Weighted<'a>> {
+    let path = character.path.display();
+    let skeleton = character
+        .skeleton
+        .as_ref()
+        .with_context(|| format!("{path}: the {role} has no skeleton"))?;
+    let weights = character
+        .reference_weights
+        .as_ref()
+        .with_context(|| format!("{path}: the {role} has no skinning weights"))?;
+    Ok(Weighted {
+        positions: &character.mesh.positions,
+        skeleton,
+        weights,
+    })
+}
+
+/// The figures as a few aligned lines.
+fn summary(e: &Evaluation) -> String {
+    let deform = |name: &str, d: Option<&atlas_skin::eval::DeformError>| match d {
+        Some(d) => format!(
+            "{name:<22} mean {:.4}  max {:.4}  (× diagonal)\n",
+            d.mean, d.max
+        ),
+        None => format!("{name:<22} (no animation)\n"),
+    };
+    let v = &e.validity;
+    [
+        format!(
+            "vertices {} (matched {}), joints {}; candidate: {} vertices, {} joints\n",
+            e.vertices, e.matched, e.joints, e.candidate_vertices, e.candidate_joints
+        ),
+        format!(
+            "{:<22} mean {:.3}  p95 {:.3}  max {:.3}  dominant joint agrees {:.1}%\n",
+            "weights L1",
+            e.weights_l1.mean,
+            e.weights_l1.p95,
+            e.weights_l1.max,
+            100.0 * e.weights_l1.dominant_agreement
+        ),
+        deform("deform, random (LBS)", Some(&e.deform_random)),
+        deform("deform, random (DQS)", Some(&e.deform_random_dqs)),
+        deform("deform, animation", e.deform_anim.as_ref()),
+        format!("{:<22} {:.4}\n", "bleeding", e.bleeding.fraction),
+        format!(
+            "{:<22} {} negative, {} sums off 1, {} unweighted, influences max {} mean {:.2}\n",
+            "validity",
+            v.negative_weights,
+            v.sums_off_one,
+            v.unweighted_vertices,
+            v.max_influences,
+            v.mean_influences
+        ),
+    ]
+    .concat()
 }

@@ -1,9 +1,53 @@
-//! Placeholder: filled in by its issue.
+//! `atlas-skin report`: the self-contained HTML report of a skinned glTF binary (see
+//! [`crate::html`]).
+
+use anyhow::{bail, Context};
+use std::path::{Path, PathBuf};
+
+pub use crate::html::write_html;
 
 /// Arguments.
 #[derive(clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// Skinned glTF binary (.glb), for example the output of `atlas-skin skin`.
+    pub input: PathBuf,
+    /// Skinning report JSON (`atlas-skin skin --report R.json`) shown in the side panel.
+    #[arg(long, value_name = "R.json")]
+    pub report: Option<PathBuf>,
+    /// A BVH motion to play in the viewer, retargeted onto the character by joint names (as
+    /// `atlas-skin animate`) and embedded as a glTF animation.
+    #[arg(long, value_name = "FILE")]
+    pub bvh: Option<PathBuf>,
+    /// The HTML file to write.
+    #[arg(short, long, value_name = "REPORT.html")]
+    pub output: PathBuf,
+}
 
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("not implemented yet")
+pub fn run(args: Args) -> anyhow::Result<()> {
+    refuse_overwrite(&args.input, &args.output)?;
+    let glb = match &args.bvh {
+        Some(bvh) => crate::cmd::animate::animate_glb_bytes(&args.input, bvh)
+            .with_context(|| format!("putting the motion {} on the character", bvh.display()))?,
+        None => std::fs::read(&args.input)
+            .with_context(|| format!("reading {}", args.input.display()))?,
+    };
+    let report = args.report.as_deref().map(read_report).transpose()?;
+    write_html(&glb, report.as_ref(), &args.output)
+        .with_context(|| format!("writing the report of {}", args.input.display()))
+}
+
+fn read_report(path: &Path) -> anyhow::Result<serde_json::Value> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    serde_json::from_str(&text).with_context(|| format!("{} is not valid JSON", path.display()))
+}
+
+/// The report must not replace its own input.
+fn refuse_overwrite(input: &Path, output: &Path) -> anyhow::Result<()> {
+    if let (Ok(input), Ok(output)) = (input.canonicalize(), output.canonicalize()) {
+        if input == output {
+            bail!("the output {} is the input file", output.display());
+        }
+    }
+    Ok(())
 }

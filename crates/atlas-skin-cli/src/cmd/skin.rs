@@ -1,9 +1,309 @@
-//! Placeholder: filled in by its issue.
+//! `atlas-skin skin`: the main job. Reads a character, computes its weights (cuts at the
+//! joints, regions, geodesic overlaps, blended weights: [`atlas_skin::pipeline::skin`]) and
+//! writes a skinned glTF binary, with an optional JSON report, debug view and HTML report.
+
+use crate::input::InputArgs;
+use anyhow::{bail, Context, Result};
+use atlas_skin::blend::Blend;
+use atlas_skin::decomposition_report::{debug_colors, debug_lines};
+use atlas_skin::pipeline::{skin, SkinParams, Skinned, Stage};
+use atlas_skin::{weld, BoundaryKind, Topology};
+use atlas_skin_io::gltf::{write_debug_glb, write_skinned_glb, WriteOptions};
+use atlas_skin_io::Character;
+use glam::Vec3;
+use indicatif::{ProgressBar, ProgressStyle};
+use serde_json::{json, Value};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 /// Arguments.
 #[derive(clap::Args)]
-pub struct Args {}
+pub struct Args {
+    #[command(flatten)]
+    pub input: InputArgs,
+    /// The skinned glTF binary to write.
+    #[arg(short, long, value_name = "OUT.glb")]
+    pub output: PathBuf,
+    /// Write a JSON report: decomposition, overlap widths, timings, counts, warnings.
+    #[arg(long, value_name = "R.json")]
+    pub report: Option<PathBuf>,
+    /// Settings as JSON (any subset of `decompose`, `weights` {`overlap` {`factor`,
+    /// `per_joint`}, `blend`}, `max_influences`); the options below override it.
+    #[arg(long, value_name = "FILE.json")]
+    pub config: Option<PathBuf>,
+    /// Overlap half-width as a multiple of each boundary's diameter (the paper: 0.5).
+    #[arg(long, value_name = "F")]
+    pub overlap: Option<f64>,
+    /// Overlap factor for one joint, repeatable: from quasi-rigid (small) to soft (large).
+    #[arg(long = "overlap-joint", value_name = "NAME=F")]
+    pub overlap_joint: Vec<String>,
+    /// How overlapping regions are blended: the normalised partition of unity (default)
+    /// or the paper's Eq. 1.
+    #[arg(long, value_enum)]
+    pub blend: Option<BlendArg>,
+    /// Influences kept per vertex (the largest, renormalised).
+    #[arg(long, value_name = "N")]
+    pub max_influences: Option<usize>,
+    /// Write an unskinned glb with the regions as vertex colours and the cut curves.
+    #[arg(long, value_name = "D.glb")]
+    pub debug_glb: Option<PathBuf>,
+    /// Write a self-contained HTML report with an interactive view of the result.
+    #[arg(long, value_name = "R.html")]
+    pub html: Option<PathBuf>,
+}
 
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("not implemented yet")
+/// `--blend` values.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub enum BlendArg {
+    /// Normalised partition of unity: continuous everywhere.
+    Pou,
+    /// The paper's Eq. 1.
+    Paper,
+}
+
+impl From<BlendArg> for Blend {
+    fn from(arg: BlendArg) -> Self {
+        match arg {
+            BlendArg::Pou => Blend::PartitionOfUnity,
+            BlendArg::Paper => Blend::Paper,
+        }
+    }
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let params = params(&args)?;
+    let character = args.input.load()?;
+    let Some(skeleton) = character.skeleton.clone() else {
+        bail!(
+            "{} has no skeleton: give one with --skeleton",
+            character.path.display()
+        );
+    };
+    let mut timings = serde_json::Map::new();
+    let ms = |start: Instant| json!(start.elapsed().as_secs_f64() * 1e3);
+
+    let progress = progress_bar();
+    progress.set_message("welding");
+    let start = Instant::now();
+    let welded = weld(
+        &character.mesh.positions,
+        &character.mesh.triangles,
+        atlas_skin::weld::DEFAULT_WELD_TOLERANCE,
+    );
+    timings.insert("weld".into(), ms(start));
+    let start = Instant::now();
+    let topology = Topology::new(&welded.mesh);
+    timings.insert("topology".into(), ms(start));
+
+    let skinned = skin(
+        &welded,
+        &topology,
+        &character.mesh.positions,
+        &skeleton,
+        &params,
+        &mut |stage: Stage| progress.set_message(stage.name()),
+    )
+    .with_context(|| format!("cannot skin {}", character.path.display()))?;
+    for (name, ms) in [
+        ("decompose", skinned.timings.decompose),
+        ("distances", skinned.timings.distances),
+        ("weights", skinned.timings.weights),
+    ] {
+        timings.insert(name.into(), json!(ms));
+    }
+
+    progress.set_message("writing");
+    let start = Instant::now();
+    let options = WriteOptions {
+        max_influences: params.max_influences,
+        ..WriteOptions::default()
+    };
+    write_skinned_glb(&character, &skinned.weights, &options, &args.output)
+        .with_context(|| format!("cannot write {}", args.output.display()))?;
+    timings.insert("write".into(), ms(start));
+    progress.finish_and_clear();
+
+    let report = report(&character, &welded.welded_of_stored, &skinned, timings);
+    if let Some(path) = &args.report {
+        let text = serde_json::to_string_pretty(&report)?;
+        std::fs::write(path, text).with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    if let Some(path) = &args.debug_glb {
+        write_debug(&skinned, path)?;
+    }
+    if let Some(path) = &args.html {
+        let glb = std::fs::read(&args.output)
+            .with_context(|| format!("cannot read back {}", args.output.display()))?;
+        crate::html::write_html(&glb, Some(&report), path)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    let d = skinned.decomposition.report();
+    println!(
+        "{}: {} vertices, {} joints ({} cut, {} soft, {} skipped), {} regions -> {}",
+        character.path.display(),
+        skinned.counts.stored_vertices,
+        skinned.counts.joints,
+        d.cuts,
+        d.soft,
+        d.skipped,
+        skinned.decomposition.regions.len(),
+        args.output.display()
+    );
+    Ok(())
+}
+
+/// Settings: the config file, then the command-line overrides.
+fn params(args: &Args) -> Result<SkinParams> {
+    let mut params: SkinParams = match &args.config {
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("cannot read {}", path.display()))?;
+            serde_json::from_str(&text)
+                .with_context(|| format!("{} is not a valid settings file", path.display()))?
+        }
+        None => SkinParams::default(),
+    };
+    if let Some(factor) = args.overlap {
+        params.weights.overlap.factor = factor;
+    }
+    for entry in &args.overlap_joint {
+        let Some((name, value)) = entry.rsplit_once('=') else {
+            bail!("--overlap-joint {entry:?}: expected NAME=F");
+        };
+        let factor: f64 = value
+            .parse()
+            .with_context(|| format!("--overlap-joint {entry:?}: {value:?} is not a number"))?;
+        params
+            .weights
+            .overlap
+            .per_joint
+            .insert(name.to_string(), factor);
+    }
+    if let Some(blend) = args.blend {
+        params.weights.blend = blend.into();
+    }
+    if let Some(n) = args.max_influences {
+        params.max_influences = n;
+    }
+    Ok(params)
+}
+
+/// A spinner with the current stage on stderr, hidden when stderr is not a terminal.
+fn progress_bar() -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new_spinner();
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} {elapsed} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+    );
+    bar.enable_steady_tick(Duration::from_millis(100));
+    bar
+}
+
+/// The JSON report: `decomposition` (the decomposition's own report, each joint with its
+/// `overlap_width` and cut `curve`, and the region of every stored vertex),
+/// `timings_ms`, `counts`, `warnings`.
+fn report(
+    character: &Character,
+    welded_of_stored: &[u32],
+    skinned: &Skinned,
+    timings: serde_json::Map<String, Value>,
+) -> Value {
+    let decomposition = &skinned.decomposition;
+    let mut decomposition_json = json!(decomposition.report());
+    if let Some(joints) = decomposition_json["joints"].as_array_mut() {
+        for (joint, decision) in joints.iter_mut().zip(&decomposition.joints) {
+            let Some(k) = decision.boundary else { continue };
+            let k = k as usize;
+            joint["overlap_width"] = json!(skinned.overlaps.half_widths[k]);
+            if let BoundaryKind::Cut { curve } = &decomposition.boundaries[k].kind {
+                let points: Vec<[f64; 3]> = curve
+                    .iter()
+                    .map(|&v| decomposition.surface.positions[v as usize].to_array())
+                    .collect();
+                joint["curve"] = json!(points);
+            }
+        }
+    }
+    // Region of every stored vertex: that of the first face of its welded vertex.
+    let mut vertex_region = vec![None; decomposition.welded_vertex_count];
+    for (f, t) in decomposition.surface.triangles.iter().enumerate().rev() {
+        for &v in t {
+            if let Some(slot) = vertex_region.get_mut(v as usize) {
+                *slot = Some(decomposition.face_region[f]);
+            }
+        }
+    }
+    decomposition_json["vertex_regions"] = json!(welded_of_stored
+        .iter()
+        .map(|&w| vertex_region.get(w as usize).copied().flatten())
+        .collect::<Vec<_>>());
+
+    let counts = &skinned.counts;
+    let mut warnings = character.warnings.clone();
+    let fallback = &counts.weights;
+    if fallback.unreachable > 0 {
+        warnings.push(format!(
+            "{} surface vertices lie where no region with joints reaches: {} took the weights \
+             of the nearest weighted vertex along the surface, {} those of the nearest bone",
+            fallback.unreachable, fallback.from_surface, fallback.from_bone
+        ));
+    }
+    if !fallback.inactive_soft_joints.is_empty() {
+        let names: Vec<&str> = fallback
+            .inactive_soft_joints
+            .iter()
+            .map(|&j| decomposition.joints[j as usize].name.as_str())
+            .collect();
+        warnings.push(format!(
+            "{} soft boundaries have no cross-section near their joint and carry no weight: {}",
+            names.len(),
+            names.join(", ")
+        ));
+    }
+    if counts.unreferenced_stored_vertices > 0 {
+        warnings.push(format!(
+            "{} stored vertices are used by no triangle: bound to their nearest bone",
+            counts.unreferenced_stored_vertices
+        ));
+    }
+    json!({
+        "input": character.path.display().to_string(),
+        "decomposition": decomposition_json,
+        "timings_ms": timings,
+        "counts": {
+            "vertices": counts.stored_vertices,
+            "welded_vertices": counts.welded_vertices,
+            "surface_vertices": counts.surface_vertices,
+            "joints": counts.joints,
+            "regions": decomposition.regions.len(),
+            "unreachable_vertices": fallback.unreachable,
+            "fallback_weighted_vertices": fallback.from_surface + fallback.from_bone
+                + counts.unreferenced_stored_vertices,
+            "max_influences": skinned.weights.max_influences(),
+        },
+        "warnings": warnings,
+    })
+}
+
+/// The debug view: the split surface coloured by region, the cut curves as lines.
+fn write_debug(skinned: &Skinned, path: &Path) -> Result<()> {
+    let d = &skinned.decomposition;
+    let positions: Vec<Vec3> = d.surface.positions.iter().map(|p| p.as_vec3()).collect();
+    let lines: Vec<[Vec3; 2]> = debug_lines(d)
+        .iter()
+        .map(|[a, b]| [Vec3::from_array(*a), Vec3::from_array(*b)])
+        .collect();
+    write_debug_glb(
+        &positions,
+        &d.surface.triangles,
+        &debug_colors(d),
+        &lines,
+        [0.0, 0.0, 0.0, 1.0],
+        path,
+    )
+    .with_context(|| format!("cannot write {}", path.display()))
 }

@@ -1,0 +1,287 @@
+//! The self-contained HTML report: one file holding a skinned glTF binary (base64), the
+//! skinning report JSON and the project's own WebGL2 viewer (`viewer/`), so that it opens
+//! from `file://` with no network request.
+//!
+//! The viewer reads these report keys, each optional: `decomposition.joints[]` (`name`,
+//! `status`, `reason`, `perimeter`, `diameter`, `overlap…`; the cut as `curve`: a closed list
+//! of `[x, y, z]` in the glb's bind space, or as `point`, `normal` and `diameter`, drawn as a
+//! circle), `decomposition.regions[]` (`joint`, `joints`: names; a vertex takes the region of
+//! its dominant joint), `decomposition.vertex_regions` (a region index per vertex of the
+//! skinned mesh, glb order; overrides the dominant joint), `timings_ms` (stage → ms),
+//! `warnings` (strings), `counts` and any other top-level scalar.
+
+use anyhow::{bail, Context};
+use base64::Engine;
+use std::io::Write;
+use std::path::Path;
+
+/// The page around the model; `@@NAME@@` markers are filled by [`fill_template`].
+const TEMPLATE: &str = include_str!("../viewer/viewer.html");
+const VIEWER_JS: &str = include_str!("../viewer/viewer.js");
+const GLSL_SKINNING: &str = include_str!("../viewer/skinning.glsl");
+const GLSL_MESH_VERT: &str = include_str!("../viewer/mesh.vert");
+const GLSL_MESH_FRAG: &str = include_str!("../viewer/mesh.frag");
+const GLSL_LINE_VERT: &str = include_str!("../viewer/line.vert");
+const GLSL_LINE_FRAG: &str = include_str!("../viewer/line.frag");
+
+/// Magic of a glTF binary: ASCII "glTF" read as a little-endian u32 (glTF 2.0 §4.4.2).
+const GLB_MAGIC: u32 = 0x4654_6c67;
+
+/// Writes `out`: an HTML page showing `glb_bytes` (a glTF 2.0 binary, skinned or not) with
+/// the optional skinning report (the JSON of `atlas-skin skin --report`; every key is
+/// optional) in its side panel. Writes a temporary file beside `out`, then renames it, so a
+/// failed write leaves no partial report.
+pub fn write_html(
+    glb_bytes: &[u8],
+    report_json: Option<&serde_json::Value>,
+    out: &Path,
+) -> anyhow::Result<()> {
+    check_glb_header(glb_bytes)?;
+    let title = out
+        .file_stem()
+        .map(|stem| stem.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "report".to_owned());
+    let report = match report_json {
+        Some(value) => script_safe_json(&with_viewer_precision(value))?,
+        None => String::new(),
+    };
+    let glb_base64 = base64::engine::general_purpose::STANDARD.encode(glb_bytes);
+    let page = fill_template(
+        TEMPLATE,
+        &[
+            ("TITLE", &escape_html(&title)),
+            ("GLB_BASE64", &glb_base64),
+            ("REPORT_JSON", &report),
+            ("GLSL_SKINNING", GLSL_SKINNING),
+            ("GLSL_MESH_VERT", GLSL_MESH_VERT),
+            ("GLSL_MESH_FRAG", GLSL_MESH_FRAG),
+            ("GLSL_LINE_VERT", GLSL_LINE_VERT),
+            ("GLSL_LINE_FRAG", GLSL_LINE_FRAG),
+            ("VIEWER_JS", VIEWER_JS),
+        ],
+    )?;
+    write_atomically(out, page.as_bytes())
+}
+
+/// Checks the 12-byte GLB header: magic, version 2 and a declared length equal to the data's.
+fn check_glb_header(bytes: &[u8]) -> anyhow::Result<()> {
+    let word = |at: usize| {
+        bytes
+            .get(at..at + 4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+    };
+    match (word(0), word(4), word(8)) {
+        (Some(GLB_MAGIC), Some(2), Some(length)) if length as usize == bytes.len() => Ok(()),
+        (Some(GLB_MAGIC), Some(2), Some(length)) => bail!(
+            "the glTF binary declares {length} bytes but has {}",
+            bytes.len()
+        ),
+        (Some(GLB_MAGIC), Some(version), _) => {
+            bail!("glTF binary version {version} is not supported (only 2)")
+        }
+        _ => bail!("not a glTF binary (.glb): the file does not start with \"glTF\""),
+    }
+}
+
+/// Replaces every `@@NAME@@` marker of `template` by its value in one pass, so text inside
+/// the values (model data, report strings) is never taken for a marker. An unknown or
+/// unclosed marker is an error.
+fn fill_template(template: &str, values: &[(&str, &str)]) -> anyhow::Result<String> {
+    let mut page =
+        String::with_capacity(template.len() + values.iter().map(|(_, v)| v.len()).sum::<usize>());
+    let mut rest = template;
+    while let Some(start) = rest.find("@@") {
+        page.push_str(&rest[..start]);
+        let after = &rest[start + 2..];
+        let end = after.find("@@").with_context(|| {
+            format!(
+                "unclosed marker in the viewer template near {:?}",
+                &after[..after.len().min(20)]
+            )
+        })?;
+        let name = &after[..end];
+        let (_, value) = values
+            .iter()
+            .find(|(key, _)| *key == name)
+            .with_context(|| format!("the viewer template has an unknown marker @@{name}@@"))?;
+        page.push_str(value);
+        rest = &after[end + 2..];
+    }
+    page.push_str(rest);
+    Ok(page)
+}
+
+/// A copy of `value` whose non-integer numbers keep 7 significant digits: the viewer works
+/// in f32 (24-bit mantissa, about 7.2 digits), and the report's curves and vectors shrink to
+/// less than half their full f64 text.
+fn with_viewer_precision(value: &serde_json::Value) -> serde_json::Value {
+    use serde_json::Value;
+    match value {
+        Value::Number(n) if !(n.is_i64() || n.is_u64()) => n
+            .as_f64()
+            .and_then(|x| format!("{x:.6e}").parse::<f64>().ok())
+            .and_then(serde_json::Number::from_f64)
+            .map_or_else(|| value.clone(), Value::Number),
+        Value::Array(items) => Value::Array(items.iter().map(with_viewer_precision).collect()),
+        Value::Object(map) => Value::Object(
+            map.iter()
+                .map(|(key, item)| (key.clone(), with_viewer_precision(item)))
+                .collect(),
+        ),
+        _ => value.clone(),
+    }
+}
+
+/// JSON that can sit inside a `<script>` element: `<` (which only occurs inside JSON
+/// strings) becomes the escape `\u003c`, so no `</script>` or `<!--` can end the element.
+fn script_safe_json(value: &serde_json::Value) -> anyhow::Result<String> {
+    let text = serde_json::to_string(value).context("serialising the report JSON")?;
+    Ok(text.replace('<', "\\u003c"))
+}
+
+/// Text for HTML element content and attribute values.
+fn escape_html(text: &str) -> String {
+    let mut escaped = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => escaped.push_str("&amp;"),
+            '<' => escaped.push_str("&lt;"),
+            '>' => escaped.push_str("&gt;"),
+            '"' => escaped.push_str("&quot;"),
+            '\'' => escaped.push_str("&#39;"),
+            _ => escaped.push(c),
+        }
+    }
+    escaped
+}
+
+/// Writes `bytes` to a temporary file in `out`'s folder, then renames it to `out`; on error
+/// the temporary file is removed.
+fn write_atomically(out: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+    let file_name = out
+        .file_name()
+        .with_context(|| format!("{} is not a file path", out.display()))?;
+    let mut temporary_name = std::ffi::OsString::from(".");
+    temporary_name.push(file_name);
+    temporary_name.push(format!(".{}.tmp", std::process::id()));
+    let temporary = out.with_file_name(temporary_name);
+    let result = std::fs::File::create(&temporary)
+        .and_then(|mut file| {
+            file.write_all(bytes)?;
+            file.sync_all()
+        })
+        .and_then(|()| std::fs::rename(&temporary, out));
+    if let Err(error) = result {
+        // Best effort: the temporary file may not exist if creating it failed.
+        let _ = std::fs::remove_file(&temporary);
+        return Err(error).with_context(|| format!("writing {}", out.display()));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A minimal valid glTF binary: header and an empty-scene JSON chunk.
+    fn tiny_glb() -> Vec<u8> {
+        let json = br#"{"asset":{"version":"2.0"}}    "#;
+        let mut bytes = Vec::new();
+        bytes.extend_from_slice(&GLB_MAGIC.to_le_bytes());
+        bytes.extend_from_slice(&2u32.to_le_bytes());
+        bytes.extend_from_slice(&((12 + 8 + json.len()) as u32).to_le_bytes());
+        bytes.extend_from_slice(&(json.len() as u32).to_le_bytes());
+        bytes.extend_from_slice(&0x4E4F_534Au32.to_le_bytes());
+        bytes.extend_from_slice(json);
+        bytes
+    }
+
+    #[test]
+    fn template_markers_are_filled_once() {
+        let page = fill_template("a @@X@@ b @@Y@@", &[("X", "@@Y@@"), ("Y", "2")]).unwrap();
+        assert_eq!(page, "a @@Y@@ b 2");
+    }
+
+    #[test]
+    fn unknown_or_unclosed_markers_are_errors() {
+        assert!(fill_template("@@Z@@", &[("X", "1")]).is_err());
+        assert!(fill_template("a @@X", &[("X", "1")]).is_err());
+    }
+
+    #[test]
+    fn viewer_template_has_every_marker_filled() {
+        let dir = std::env::temp_dir().join(format!("atlas-skin-html-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let out = dir.join("tiny.html");
+        write_html(&tiny_glb(), None, &out).unwrap();
+        let page = std::fs::read_to_string(&out).unwrap();
+        std::fs::remove_dir_all(&dir).unwrap();
+        assert!(!page.contains("@@"), "a marker was left in the page");
+        assert!(page.contains("<title>atlas-skin report: tiny</title>"));
+    }
+
+    #[test]
+    fn embedded_sources_cannot_close_their_script_element() {
+        for source in [
+            VIEWER_JS,
+            GLSL_SKINNING,
+            GLSL_MESH_VERT,
+            GLSL_MESH_FRAG,
+            GLSL_LINE_VERT,
+            GLSL_LINE_FRAG,
+        ] {
+            assert!(!source.to_ascii_lowercase().contains("</script"));
+            assert!(
+                !source.contains("@@"),
+                "a source contains the template marker"
+            );
+        }
+    }
+
+    #[test]
+    fn report_strings_cannot_close_the_script_element() {
+        let value = serde_json::json!({ "warnings": ["</script><script>alert(1)</script>"] });
+        let text = script_safe_json(&value).unwrap();
+        assert!(!text.contains('<'));
+        let back: serde_json::Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, value);
+    }
+
+    #[test]
+    fn report_numbers_keep_seven_significant_digits() {
+        let value = serde_json::json!({
+            "curve": [[1.1198194281633318, -0.000123456789, 12345678.9]],
+            "count": 16000,
+            "name": "spine",
+        });
+        let compact = with_viewer_precision(&value);
+        assert_eq!(
+            compact,
+            serde_json::json!({
+                "curve": [[1.119819, -0.0001234568, 12345680.0]],
+                "count": 16000,
+                "name": "spine",
+            })
+        );
+    }
+
+    #[test]
+    fn titles_are_escaped() {
+        assert_eq!(
+            escape_html(r#"<a href="x">&'"#),
+            "&lt;a href=&quot;x&quot;&gt;&amp;&#39;"
+        );
+    }
+
+    #[test]
+    fn bad_glb_headers_are_rejected() {
+        let glb = tiny_glb();
+        assert!(check_glb_header(&glb).is_ok());
+        assert!(check_glb_header(b"{\"asset\":{}}").is_err());
+        assert!(check_glb_header(&glb[..glb.len() - 1]).is_err());
+        let mut version_1 = glb.clone();
+        version_1[4] = 1;
+        assert!(check_glb_header(&version_1).is_err());
+        assert!(check_glb_header(&[]).is_err());
+    }
+}

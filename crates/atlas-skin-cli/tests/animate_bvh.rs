@@ -1,0 +1,139 @@
+//! `atlas-skin animate`: a BVH motion put on a character whose skeleton is the motion's
+//! own comes back as a glTF animation that reproduces every joint's motion, passes the
+//! Khronos validator, and as an OBJ sequence with one posed mesh per frame.
+
+use atlas_skin_io::gltf::{write_skinned_glb, WriteOptions};
+use atlas_skin_io::{Character, TriangleMesh};
+use atlas_skin_runtime::{Rig, Trs, VertexWeights};
+use glam::{Mat4, Vec3};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const MOTION: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../../shared/data/motion/walk.bvh"
+);
+const WORKSPACE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("atlas-skin-animate-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temporary directory");
+    dir.join(name)
+}
+
+/// A character made of one small tetrahedron at every joint of the BVH skeleton, each
+/// bound rigidly to its joint, written as a skinned glb.
+fn bvh_character(out: &Path) {
+    let motion = Path::new(MOTION);
+    assert!(
+        motion.exists(),
+        "motion file {} is missing",
+        motion.display()
+    );
+    let skeleton = atlas_skin_io::bvh::read(motion).expect("read BVH skeleton");
+    let corners = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
+    let mut mesh = TriangleMesh::default();
+    let mut rows = Vec::new();
+    for (joint, position) in skeleton.bind_positions().iter().enumerate() {
+        let base = mesh.positions.len() as u32;
+        mesh.positions
+            .extend(corners.iter().map(|c| *position + *c));
+        mesh.triangles
+            .extend([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]].map(|t| t.map(|i| base + i)));
+        rows.extend(std::iter::repeat_n(vec![(joint as u32, 1.0)], 4));
+    }
+    let mut character = Character::new("bvh-character", mesh);
+    character.skeleton = Some(skeleton);
+    write_skinned_glb(
+        &character,
+        &VertexWeights::from_rows(rows),
+        &WriteOptions::default(),
+        out,
+    )
+    .expect("write glb");
+}
+
+fn animate(input: &Path, out: &Path) {
+    let output = Command::new(env!("CARGO_BIN_EXE_atlas-skin"))
+        .arg("animate")
+        .arg(input)
+        .arg("--bvh")
+        .arg(MOTION)
+        .arg("-o")
+        .arg(out)
+        .output()
+        .expect("run atlas-skin");
+    assert!(
+        output.status.success(),
+        "animate failed: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+}
+
+/// World position of every joint of `rig` in a pose.
+fn joint_positions(rig: &Rig, local: &[Trs]) -> Vec<Vec3> {
+    let mut world = vec![Mat4::IDENTITY; rig.len()];
+    rig.world(local, &mut world);
+    rig.joint_nodes
+        .iter()
+        .map(|&n| world[n as usize].w_axis.truncate())
+        .collect()
+}
+
+#[test]
+fn animation_reproduces_the_motion_on_its_own_skeleton() {
+    let input = scratch("character.glb");
+    let out = scratch("animated.glb");
+    bvh_character(&input);
+    animate(&input, &out);
+
+    let (_, source_rig, source_clip) = atlas_skin_io::bvh::read_motion(Path::new(MOTION)).unwrap();
+    let animated = atlas_skin_io::load_character(&out, &Default::default()).expect("read output");
+    let rig = animated.rig.as_ref().expect("rig");
+    let clip = animated.clips.last().expect("an animation");
+    clip.validate(rig.len()).expect("valid animation");
+    let frame_times = &source_clip.tracks[0].times;
+    let mut source_local = source_rig.rest.clone();
+    let mut local = rig.rest.clone();
+    for &time in frame_times.iter().step_by(37) {
+        source_clip.sample(time, &source_rig.rest, &mut source_local);
+        clip.sample(time, &rig.rest, &mut local);
+        let expected = joint_positions(&source_rig, &source_local);
+        let got = joint_positions(rig, &local);
+        for (j, (e, g)) in expected.iter().zip(&got).enumerate() {
+            assert!(
+                e.abs_diff_eq(*g, 1e-3),
+                "t = {time}, joint {j}: {g} instead of {e}"
+            );
+        }
+    }
+
+    let validator = Command::new("node")
+        .current_dir(WORKSPACE)
+        .arg("tests/js/validate.mjs")
+        .arg(&out)
+        .output()
+        .expect("run node (install it with scripts/install-test-deps)");
+    assert!(
+        validator.status.success(),
+        "validator: {}",
+        String::from_utf8_lossy(&validator.stdout)
+    );
+}
+
+#[test]
+fn obj_sequence_has_one_posed_mesh_per_frame() {
+    let input = scratch("sequence-character.glb");
+    bvh_character(&input);
+    let out = scratch("sequence/walk.obj");
+    std::fs::create_dir_all(out.parent().unwrap()).unwrap();
+    animate(&input, &out);
+    let (_, _, clip) = atlas_skin_io::bvh::read_motion(Path::new(MOTION)).unwrap();
+    let frames = clip.tracks[0].times.len();
+    let count = std::fs::read_dir(out.parent().unwrap()).unwrap().count();
+    assert_eq!(count, frames);
+    let first = std::fs::read_to_string(scratch("sequence/walk_0001.obj")).expect("first frame");
+    let last = std::fs::read_to_string(scratch(&format!("sequence/walk_{frames:04}.obj")))
+        .expect("last frame");
+    assert_ne!(first, last, "the mesh moves");
+}

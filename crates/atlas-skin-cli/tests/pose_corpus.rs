@@ -1,0 +1,173 @@
+//! The fast skinning job equals the scalar reference (atlas_skin_runtime::reference) within
+//! 1e-5 of the bounding-box diagonal on every corpus model with weights, for linear blend
+//! and dual quaternion skinning of seeded random poses, sequential and parallel.
+
+use atlas_skin_io::LoadOptions;
+use atlas_skin_runtime::pose::palette_from_world;
+use atlas_skin_runtime::random_pose::random_rotations;
+use atlas_skin_runtime::reference::{
+    dual_quaternion_positions, dual_quaternion_vectors, linear_blend_positions,
+    linear_blend_vectors,
+};
+use atlas_skin_runtime::{
+    CompactSkin, Rig, SkinningJob, SkinningMethod, SkinningPalette, Threading,
+};
+use glam::{Mat4, Vec3};
+use std::path::Path;
+
+const MODELS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/models");
+
+/// (folder, input, skeleton, group, weights)
+type Model = (
+    &'static str,
+    &'static str,
+    Option<&'static str>,
+    Option<&'static str>,
+    Option<&'static str>,
+);
+
+const CORPUS: [Model; 7] = [
+    ("cesiumman", "CesiumMan.glb", None, None, None),
+    ("riggedfigure", "RiggedFigure.glb", None, None, None),
+    ("riggedsimple", "RiggedSimple.glb", None, None, None),
+    ("simpleskin", "SimpleSkin.gltf", None, None, None),
+    (
+        "arm",
+        "arm.obj",
+        Some("arm.tgf"),
+        None,
+        Some("arm-weights.dmat"),
+    ),
+    (
+        "elephant",
+        "elephant.obj",
+        Some("elephant.tgf"),
+        None,
+        Some("elephant-weights.dmat"),
+    ),
+    (
+        "makehuman",
+        "base.obj",
+        Some("default.mhskel"),
+        Some("body"),
+        Some("default_weights.mhw"),
+    ),
+];
+
+fn diagonal(points: &[Vec3]) -> f32 {
+    let (lo, hi) = points.iter().fold((Vec3::MAX, Vec3::MIN), |(lo, hi), p| {
+        (lo.min(*p), hi.max(*p))
+    });
+    (hi - lo).length()
+}
+
+fn max_distance(a: &[Vec3], b: &[Vec3]) -> f32 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| x.distance(*y))
+        .fold(0.0, f32::max)
+}
+
+#[test]
+fn fast_paths_match_the_reference_on_the_corpus() {
+    for (folder, input, skeleton, group, weights) in CORPUS {
+        let dir = Path::new(MODELS).join(folder);
+        let path = dir.join(input);
+        assert!(path.exists(), "corpus file {} is missing", path.display());
+        let options = LoadOptions {
+            skeleton: skeleton.map(|s| dir.join(s)),
+            group: group.map(String::from),
+            weights: weights.map(|w| dir.join(w)),
+        };
+        let character = atlas_skin_io::load_character(&path, &options).expect("load");
+        let skeleton = character.skeleton.as_ref().expect("skeleton");
+        let rig = character
+            .rig
+            .clone()
+            .unwrap_or_else(|| Rig::from_skeleton(skeleton));
+        let rows = character.reference_weights.as_ref().expect("weights");
+        let rest = &character.mesh.positions;
+        let normals: Vec<Vec3> = rest
+            .iter()
+            .map(|p| (*p - rest[0]).normalize_or(Vec3::Y))
+            .collect();
+        // Elephant rows have up to 23 influences: the N path with 8.
+        for max_influences in [4, 8] {
+            let skin =
+                CompactSkin::new(rows, skeleton.len(), max_influences).expect("valid weights");
+            let reference_weights = skin.to_vertex_weights();
+            let tolerance = 1e-5 * diagonal(rest);
+            for seed in 0..3 {
+                let mut local = rig.rest.clone();
+                let rotations = random_rotations(skeleton.len(), 1.0, seed);
+                for (&node, q) in rig.joint_nodes.iter().zip(&rotations) {
+                    local[node as usize].rotation *= *q;
+                }
+                let mut node_world = vec![Mat4::IDENTITY; rig.len()];
+                let mut joint_world = vec![Mat4::IDENTITY; skeleton.len()];
+                let mut matrices = vec![Mat4::IDENTITY; skeleton.len()];
+                rig.world(&local, &mut node_world);
+                rig.joint_world(&node_world, &mut joint_world);
+                palette_from_world(&joint_world, &skeleton.inverse_bind, &mut matrices);
+                for method in [SkinningMethod::LinearBlend, SkinningMethod::DualQuaternion] {
+                    let mut palette = SkinningPalette::new(skeleton.len());
+                    palette.update(&matrices, method).expect("rigid palette");
+                    let mut expected = vec![Vec3::ZERO; rest.len()];
+                    let mut expected_normals = vec![Vec3::ZERO; rest.len()];
+                    match method {
+                        SkinningMethod::LinearBlend => {
+                            linear_blend_positions(
+                                rest,
+                                &reference_weights,
+                                &matrices,
+                                &mut expected,
+                            );
+                            linear_blend_vectors(
+                                &normals,
+                                &reference_weights,
+                                &matrices,
+                                &mut expected_normals,
+                            );
+                        }
+                        SkinningMethod::DualQuaternion => {
+                            dual_quaternion_positions(
+                                rest,
+                                &reference_weights,
+                                &matrices,
+                                &mut expected,
+                            );
+                            dual_quaternion_vectors(
+                                &normals,
+                                &reference_weights,
+                                &matrices,
+                                &mut expected_normals,
+                            );
+                        }
+                    }
+                    for threading in [Threading::Sequential, Threading::Parallel] {
+                        let mut positions = vec![Vec3::ZERO; rest.len()];
+                        let mut out_normals = vec![Vec3::ZERO; rest.len()];
+                        SkinningJob {
+                            skin: &skin,
+                            palette: &palette,
+                            threading,
+                            rest_positions: rest,
+                            rest_normals: Some(&normals),
+                            rest_tangents: None,
+                            out_positions: &mut positions,
+                            out_normals: Some(&mut out_normals),
+                            out_tangents: None,
+                        }
+                        .run()
+                        .expect("valid job");
+                        let what = format!("{folder}, K ≤ {max_influences}, seed {seed}, {method:?}, {threading:?}");
+                        let error = max_distance(&positions, &expected);
+                        assert!(error <= tolerance, "{what}: positions off by {error}");
+                        let error = max_distance(&out_normals, &expected_normals);
+                        assert!(error <= 1e-5, "{what}: normals off by {error}");
+                    }
+                }
+            }
+        }
+    }
+}

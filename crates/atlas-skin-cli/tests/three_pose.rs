@@ -1,0 +1,155 @@
+//! `atlas-skin pose` agrees with three.js's own skinning (tests/js/three_pose.mjs:
+//! GLTFLoader + SkinnedMesh.getVertexPosition) on the corpus glTF models, for animation
+//! frames and for a pose file, within 1e-5 of the bounding-box diagonal.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const MODELS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/models");
+const WORKSPACE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
+
+/// (folder, file, joints turned by the pose file)
+const CORPUS: [(&str, &str, &[&str]); 3] = [
+    (
+        "cesiumman",
+        "CesiumMan.glb",
+        &["node3", "node11", "node16", "node8"],
+    ),
+    (
+        "riggedfigure",
+        "RiggedFigure.glb",
+        &["node3", "node11", "node16", "node8"],
+    ),
+    ("riggedsimple", "RiggedSimple.glb", &["node2", "node3"]),
+];
+
+fn model(folder: &str, file: &str) -> PathBuf {
+    let path = Path::new(MODELS).join(folder).join(file);
+    assert!(path.exists(), "corpus file {} is missing", path.display());
+    path
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("atlas-skin-three-pose-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temporary directory");
+    dir.join(name)
+}
+
+/// Vertex positions of `atlas-skin pose INPUT ARGS -o OUT.obj`.
+fn atlas_pose(input: &Path, args: &[&str], out: &Path) -> Vec<[f64; 3]> {
+    let output = Command::new(env!("CARGO_BIN_EXE_atlas-skin"))
+        .arg("pose")
+        .arg(input)
+        .args(args)
+        .arg("-o")
+        .arg(out)
+        .output()
+        .expect("run atlas-skin");
+    assert!(
+        output.status.success(),
+        "atlas-skin pose failed: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let text = std::fs::read_to_string(out).expect("pose wrote the OBJ");
+    text.lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            let v: Vec<f64> = l
+                .split_whitespace()
+                .map(|x| x.parse().expect("number"))
+                .collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect()
+}
+
+/// Vertex positions three.js computes for the same input and pose.
+fn three_pose(input: &Path, args: &[&str]) -> Vec<[f64; 3]> {
+    let modules = Path::new(WORKSPACE).join("tests/js/node_modules/three");
+    assert!(
+        modules.exists(),
+        "{} is missing: run scripts/install-test-deps",
+        modules.display()
+    );
+    let output = Command::new("node")
+        .current_dir(WORKSPACE)
+        .arg("tests/js/three_pose.mjs")
+        .arg(input)
+        .args(args)
+        .output()
+        .expect("run node (install it with scripts/install-test-deps)");
+    assert!(
+        output.status.success(),
+        "three_pose.mjs failed: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).expect("JSON");
+    let flat: Vec<f64> = json["positions"]
+        .as_array()
+        .expect("positions")
+        .iter()
+        .map(|x| x.as_f64().expect("number"))
+        .collect();
+    flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()
+}
+
+fn assert_agree(what: &str, ours: &[[f64; 3]], theirs: &[[f64; 3]]) {
+    assert_eq!(ours.len(), theirs.len(), "{what}: vertex count");
+    let mut lo = [f64::MAX; 3];
+    let mut hi = [f64::MIN; 3];
+    for p in theirs {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let diagonal = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
+    let worst = ours
+        .iter()
+        .zip(theirs)
+        .map(|(a, b)| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>().sqrt())
+        .fold(0.0, f64::max);
+    assert!(
+        worst <= 1e-5 * diagonal,
+        "{what}: largest distance {worst:e} > 1e-5 × diagonal {diagonal}"
+    );
+}
+
+#[test]
+fn animation_frames_agree_with_three_js() {
+    for (folder, file, _) in CORPUS {
+        let input = model(folder, file);
+        for time in ["0.3", "0.95"] {
+            let out = scratch(&format!("{folder}-anim-{time}.obj"));
+            let ours = atlas_pose(&input, &["--anim", "0", "--time", time], &out);
+            let theirs = three_pose(&input, &["--anim", "0", "--time", time]);
+            assert_agree(&format!("{folder} at {time} s"), &ours, &theirs);
+        }
+    }
+}
+
+#[test]
+fn pose_files_agree_with_three_js() {
+    for (folder, file, joints) in CORPUS {
+        let input = model(folder, file);
+        // Unit quaternions of 30° to 50° about assorted axes.
+        let rotations = [
+            [0.2588, 0.0, 0.0, 0.9659],
+            [0.0, 0.3420, 0.0, 0.9397],
+            [0.1, 0.2, 0.3, 0.9274],
+            [-0.3, 0.1, 0.2, 0.9274],
+        ];
+        let pose: serde_json::Map<String, serde_json::Value> = joints
+            .iter()
+            .zip(rotations)
+            .map(|(name, q)| (name.to_string(), serde_json::json!(q)))
+            .collect();
+        let pose_path = scratch(&format!("{folder}-pose.json"));
+        std::fs::write(&pose_path, serde_json::Value::Object(pose).to_string()).unwrap();
+        let pose_arg = pose_path.to_str().expect("UTF-8 path");
+        let out = scratch(&format!("{folder}-pose.obj"));
+        let ours = atlas_pose(&input, &["--pose", pose_arg], &out);
+        let theirs = three_pose(&input, &["--pose", pose_arg]);
+        assert_agree(&format!("{folder} pose file"), &ours, &theirs);
+    }
+}

@@ -1,0 +1,187 @@
+//! Building a single-buffer `.glb`: a JSON document plus one BIN chunk that grows as
+//! bufferViews and accessors are appended.
+
+use super::accessor::ComponentType;
+use super::container::glb_bytes;
+use serde_json::{json, Map, Value};
+
+/// `bufferView.target` of vertex attributes.
+pub(crate) const ARRAY_BUFFER: u32 = 34962;
+/// `bufferView.target` of vertex indices.
+pub(crate) const ELEMENT_ARRAY_BUFFER: u32 = 34963;
+
+/// A glTF document being written with its binary buffer (buffer 0 of the output).
+pub(crate) struct GlbBuilder {
+    json: Map<String, Value>,
+    bin: Vec<u8>,
+}
+
+impl GlbBuilder {
+    /// Starts from the top-level object `json` (its `buffers` are replaced on
+    /// [`GlbBuilder::finish`]).
+    pub fn new(json: Map<String, Value>) -> Self {
+        Self {
+            json,
+            bin: Vec::new(),
+        }
+    }
+
+    /// The document's top-level object.
+    pub fn json_mut(&mut self) -> &mut Map<String, Value> {
+        &mut self.json
+    }
+
+    /// Appends `item` to the top-level array `key` (created when missing) and returns its
+    /// index.
+    pub fn push_item(&mut self, key: &str, item: Value) -> usize {
+        let entry = self
+            .json
+            .entry(key)
+            .or_insert_with(|| Value::Array(Vec::new()));
+        match entry {
+            Value::Array(items) => {
+                items.push(item);
+                items.len() - 1
+            }
+            other => {
+                *other = Value::Array(vec![item]);
+                0
+            }
+        }
+    }
+
+    /// Appends `bytes` to the binary buffer at an offset congruent to `phase` modulo 4
+    /// (0 for new data; the old offset's phase when copying a view, so the accessors inside
+    /// keep their alignment) and returns that offset.
+    pub fn append_bytes(&mut self, bytes: &[u8], phase: usize) -> usize {
+        let offset = self.bin.len().next_multiple_of(4) + phase % 4;
+        self.bin.resize(offset, 0);
+        self.bin.extend_from_slice(bytes);
+        offset
+    }
+
+    /// Appends `bytes` as a new bufferView (4-byte aligned) and returns its index.
+    pub fn push_view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
+        let offset = self.append_bytes(bytes, 0);
+        let mut view = json!({"buffer": 0, "byteOffset": offset, "byteLength": bytes.len()});
+        if let Some(target) = target {
+            view["target"] = json!(target);
+        }
+        self.push_item("bufferViews", view)
+    }
+
+    /// Appends an accessor over the whole of bufferView `view`.
+    fn push_accessor(
+        &mut self,
+        view: usize,
+        component: ComponentType,
+        type_name: &str,
+        count: usize,
+        bounds: Option<(Vec<f32>, Vec<f32>)>,
+    ) -> usize {
+        let mut accessor = json!({
+            "bufferView": view,
+            "componentType": component.code(),
+            "count": count,
+            "type": type_name,
+        });
+        if let Some((min, max)) = bounds {
+            accessor["min"] = json!(min);
+            accessor["max"] = json!(max);
+        }
+        self.push_item("accessors", accessor)
+    }
+
+    /// Appends float `values` (flattened elements of `type_name`) as a view and an accessor,
+    /// with per-component `min`/`max` when `with_bounds`.
+    pub fn push_f32_accessor(
+        &mut self,
+        values: &[f32],
+        type_name: &str,
+        with_bounds: bool,
+        target: Option<u32>,
+    ) -> usize {
+        let components = components_of(type_name);
+        let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let view = self.push_view(&bytes, target);
+        let bounds = with_bounds.then(|| component_bounds(values, components));
+        self.push_accessor(
+            view,
+            ComponentType::F32,
+            type_name,
+            values.len() / components,
+            bounds,
+        )
+    }
+
+    /// Appends unsigned integer `values` (flattened elements of `type_name`) stored as
+    /// `component` (U8, U16 or U32; every value must fit).
+    pub fn push_uint_accessor(
+        &mut self,
+        values: &[u32],
+        component: ComponentType,
+        type_name: &str,
+        target: Option<u32>,
+    ) -> usize {
+        let bytes: Vec<u8> = match component {
+            ComponentType::U8 => values.iter().map(|&v| v as u8).collect(),
+            ComponentType::U16 => values
+                .iter()
+                .flat_map(|&v| (v as u16).to_le_bytes())
+                .collect(),
+            _ => values.iter().flat_map(|v| v.to_le_bytes()).collect(),
+        };
+        debug_assert!(values
+            .iter()
+            .all(|&v| (v as u64) < 1u64 << (8 * component.size())));
+        let view = self.push_view(&bytes, target);
+        let count = values.len() / components_of(type_name);
+        self.push_accessor(view, component, type_name, count, None)
+    }
+
+    /// The finished `.glb`: one buffer holding everything appended.
+    pub fn finish(mut self) -> Vec<u8> {
+        if self.bin.is_empty() {
+            self.json.remove("buffers");
+        } else {
+            self.json
+                .insert("buffers".into(), json!([{"byteLength": self.bin.len()}]));
+        }
+        glb_bytes(&Value::Object(self.json), &self.bin)
+    }
+}
+
+/// Components per element of the accessor types the writers use.
+fn components_of(type_name: &str) -> usize {
+    match type_name {
+        "SCALAR" => 1,
+        "VEC2" => 2,
+        "VEC3" => 3,
+        "VEC4" => 4,
+        "MAT4" => 16,
+        other => unreachable!("writers never use accessor type {other}"),
+    }
+}
+
+/// Per-component minimum and maximum of flattened elements with `components` each.
+fn component_bounds(values: &[f32], components: usize) -> (Vec<f32>, Vec<f32>) {
+    let mut min = vec![f32::INFINITY; components];
+    let mut max = vec![f32::NEG_INFINITY; components];
+    for element in values.chunks_exact(components) {
+        for (c, &v) in element.iter().enumerate() {
+            min[c] = min[c].min(v);
+            max[c] = max[c].max(v);
+        }
+    }
+    (min, max)
+}
+
+/// The smallest index component type for vertex indices below `vertex_count`.
+pub(crate) fn index_component(vertex_count: usize) -> ComponentType {
+    // 65535 is the primitive-restart value of UNSIGNED_SHORT and may not be used.
+    if vertex_count <= 65535 {
+        ComponentType::U16
+    } else {
+        ComponentType::U32
+    }
+}

@@ -1,0 +1,329 @@
+//! The glTF containers: a `.glb` binary (12-byte header, JSON chunk, optional BIN chunk), or
+//! a `.gltf` JSON file whose buffers are base64 `data:` URIs or files beside it.
+
+use crate::IoError;
+use base64::Engine;
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+
+/// The first 4 bytes of a GLB file (glTF 2.0 §4.4.2).
+const GLB_MAGIC: &[u8; 4] = b"glTF";
+const GLB_HEADER_BYTES: usize = 12;
+const CHUNK_HEADER_BYTES: usize = 8;
+const CHUNK_JSON: u32 = 0x4E4F_534A;
+const CHUNK_BIN: u32 = 0x004E_4942;
+
+/// A glTF document as read: its JSON and the bytes of every buffer, in `buffers` order.
+pub(crate) struct Container {
+    pub json: Value,
+    pub buffers: Vec<Vec<u8>>,
+}
+
+/// Reads the `.glb`, `.vrm` or `.gltf` file at `path` and every buffer it refers to.
+///
+/// The content decides the container: a file starting with `glTF` is a binary, anything
+/// else must be a `.gltf` JSON file.
+pub(crate) fn read_container(path: &Path) -> Result<Container, IoError> {
+    let bytes = read_file(path)?;
+    let is_binary_name = matches!(extension(path).as_str(), "glb" | "vrm");
+    let (json_bytes, bin) = if bytes.starts_with(GLB_MAGIC) {
+        split_glb(path, &bytes)?
+    } else if is_binary_name {
+        let shown = &bytes[..bytes.len().min(4)];
+        return Err(IoError::invalid(
+            path,
+            format!(
+                "not a binary glTF: the file starts with {:?} instead of the magic \"glTF\"",
+                String::from_utf8_lossy(shown)
+            ),
+        ));
+    } else {
+        (bytes.as_slice(), None)
+    };
+    let json = parse_json(path, json_bytes)?;
+    let buffers = load_buffers(path, &json, bin)?;
+    Ok(Container { json, buffers })
+}
+
+/// The file's bytes; a directory or an empty file is an error of its own.
+fn read_file(path: &Path) -> Result<Vec<u8>, IoError> {
+    if path.is_dir() {
+        return Err(IoError::IsDirectory {
+            path: path.to_path_buf(),
+        });
+    }
+    let bytes = std::fs::read(path).map_err(|source| IoError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    if bytes.is_empty() {
+        return Err(IoError::Empty {
+            path: path.to_path_buf(),
+        });
+    }
+    Ok(bytes)
+}
+
+/// Lower-case extension of `path`, empty when it has none.
+fn extension(path: &Path) -> String {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase()
+}
+
+fn read_u32(bytes: &[u8], at: usize) -> Option<u32> {
+    let word = bytes.get(at..at.checked_add(4)?)?;
+    Some(u32::from_le_bytes([word[0], word[1], word[2], word[3]]))
+}
+
+/// Splits a GLB file into its JSON chunk and its BIN chunk (if any), checking the header
+/// and every chunk length against the file size.
+fn split_glb<'a>(path: &Path, bytes: &'a [u8]) -> Result<(&'a [u8], Option<Vec<u8>>), IoError> {
+    let error = |message: String| IoError::invalid(path, message);
+    if bytes.len() < GLB_HEADER_BYTES {
+        return Err(error(format!(
+            "truncated glb: {} bytes, shorter than the 12-byte header",
+            bytes.len()
+        )));
+    }
+    let version = read_u32(bytes, 4).unwrap_or(0);
+    if version != 2 {
+        return Err(error(format!(
+            "glb container version {version}, expected 2"
+        )));
+    }
+    let declared = read_u32(bytes, 8).unwrap_or(0) as usize;
+    if declared != bytes.len() {
+        let what = if declared > bytes.len() {
+            "truncated glb"
+        } else {
+            "bad glb length"
+        };
+        return Err(error(format!(
+            "{what}: the header says {declared} bytes, the file has {}",
+            bytes.len()
+        )));
+    }
+    let mut json = None;
+    let mut bin = None;
+    let mut offset = GLB_HEADER_BYTES;
+    let mut chunk_index = 0;
+    while offset < bytes.len() {
+        let (Some(length), Some(kind)) = (read_u32(bytes, offset), read_u32(bytes, offset + 4))
+        else {
+            return Err(error(format!(
+                "truncated glb: chunk {chunk_index} header at byte {offset} runs past the end"
+            )));
+        };
+        let start = offset + CHUNK_HEADER_BYTES;
+        let end = start
+            .checked_add(length as usize)
+            .filter(|&e| e <= bytes.len());
+        let Some(end) = end else {
+            return Err(error(format!(
+                "bad glb chunk length: chunk {chunk_index} at byte {offset} declares {length} \
+                 bytes, only {} remain",
+                bytes.len() - start
+            )));
+        };
+        match (chunk_index, kind) {
+            (0, CHUNK_JSON) => json = Some(&bytes[start..end]),
+            (0, _) => {
+                return Err(error(format!(
+                    "the first glb chunk has type 0x{kind:08X}, expected JSON (0x{CHUNK_JSON:08X})"
+                )))
+            }
+            (1, CHUNK_BIN) => bin = Some(bytes[start..end].to_vec()),
+            // Unknown chunk types must be ignored (glTF 2.0 §4.4.3.1).
+            _ => {}
+        }
+        offset = end;
+        chunk_index += 1;
+    }
+    let json = json.ok_or_else(|| error("the glb has no JSON chunk".into()))?;
+    Ok((json, bin))
+}
+
+/// Parses the JSON and checks that it is a glTF 2.x document (an object with `asset.version`
+/// starting with "2.").
+fn parse_json(path: &Path, bytes: &[u8]) -> Result<Value, IoError> {
+    let json: Value = serde_json::from_slice(bytes)
+        .map_err(|e| IoError::invalid(path, format!("invalid glTF JSON: {e}")))?;
+    let version = json
+        .get("asset")
+        .and_then(|asset| asset.get("version"))
+        .and_then(Value::as_str);
+    match version {
+        None => Err(IoError::invalid(
+            path,
+            "not a glTF document: the JSON has no \"asset\" object with a \"version\"",
+        )),
+        Some(v) if v.split('.').next() != Some("2") => Err(IoError::invalid(
+            path,
+            format!("glTF version {v:?} is not supported (expected 2.x)"),
+        )),
+        Some(_) => Ok(json),
+    }
+}
+
+/// Loads every buffer of the document: the GLB BIN chunk for a buffer without `uri`, a
+/// base64 `data:` URI, or a file relative to the document's folder. Each buffer is cut to
+/// its `byteLength`, and must be at least that long.
+fn load_buffers(path: &Path, json: &Value, bin: Option<Vec<u8>>) -> Result<Vec<Vec<u8>>, IoError> {
+    let empty = Vec::new();
+    let declared = match json.get("buffers") {
+        None => &empty,
+        Some(Value::Array(buffers)) => buffers,
+        Some(_) => return Err(IoError::invalid(path, "\"buffers\" is not an array")),
+    };
+    let mut bin = bin;
+    let mut buffers = Vec::with_capacity(declared.len());
+    for (index, buffer) in declared.iter().enumerate() {
+        let byte_length = buffer
+            .get("byteLength")
+            .and_then(Value::as_u64)
+            .ok_or_else(|| {
+                IoError::invalid(path, format!("buffers[{index}] has no valid byteLength"))
+            })?;
+        let mut bytes = match buffer.get("uri") {
+            None if index == 0 => bin.take().ok_or_else(|| {
+                IoError::invalid(
+                    path,
+                    "buffers[0] has no uri and the file has no glb BIN chunk",
+                )
+            })?,
+            None => {
+                return Err(IoError::invalid(
+                    path,
+                    format!(
+                        "buffers[{index}] has no uri (only buffer 0 may use the glb BIN chunk)"
+                    ),
+                ))
+            }
+            Some(Value::String(uri)) => {
+                load_uri(path, uri)
+                    .map_err(|e| IoError::invalid(path, format!("buffers[{index}]: {e}")))?
+                    .0
+            }
+            Some(_) => {
+                return Err(IoError::invalid(
+                    path,
+                    format!("buffers[{index}].uri is not a string"),
+                ))
+            }
+        };
+        if (bytes.len() as u64) < byte_length {
+            return Err(IoError::invalid(
+                path,
+                format!(
+                    "buffers[{index}] has {} bytes, less than its byteLength {byte_length}",
+                    bytes.len()
+                ),
+            ));
+        }
+        bytes.truncate(byte_length as usize);
+        buffers.push(bytes);
+    }
+    Ok(buffers)
+}
+
+/// The bytes a URI of the document at `document_path` points to, and the media type a
+/// `data:` URI declares. Relative URIs are percent-decoded and resolved against the
+/// document's folder.
+pub(crate) fn load_uri(
+    document_path: &Path,
+    uri: &str,
+) -> Result<(Vec<u8>, Option<String>), String> {
+    if let Some(data) = uri.strip_prefix("data:") {
+        let (header, payload) = data.split_once(',').ok_or("a data: URI without a comma")?;
+        let media_type = header.strip_suffix(";base64").ok_or_else(|| {
+            format!("data: URI with header {header:?} is not base64 (only base64 is supported)")
+        })?;
+        let bytes = base64::engine::general_purpose::STANDARD
+            .decode(payload.trim())
+            .map_err(|e| format!("bad base64 in data: URI: {e}"))?;
+        let media_type = (!media_type.is_empty()).then(|| media_type.to_string());
+        return Ok((bytes, media_type));
+    }
+    if uri.contains("://") {
+        return Err(format!("external URI {uri:?} is not a local file"));
+    }
+    let relative = percent_decode(uri)?;
+    let file: PathBuf = document_path
+        .parent()
+        .unwrap_or(Path::new(""))
+        .join(relative);
+    std::fs::read(&file)
+        .map(|bytes| (bytes, None))
+        .map_err(|e| format!("cannot read {}: {e}", file.display()))
+}
+
+/// Decodes `%XX` escapes of a URI path (RFC 3986 §2.1).
+fn percent_decode(uri: &str) -> Result<String, String> {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%' {
+            let hex = bytes
+                .get(i + 1..i + 3)
+                .and_then(|h| std::str::from_utf8(h).ok())
+                .and_then(|h| u8::from_str_radix(h, 16).ok())
+                .ok_or_else(|| format!("bad percent escape in URI {uri:?}"))?;
+            out.push(hex);
+            i += 3;
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8(out).map_err(|_| format!("URI {uri:?} does not decode to UTF-8"))
+}
+
+/// A GLB file holding `json` and, when `bin` is not empty, a BIN chunk. Chunks are padded
+/// to 4 bytes: JSON with spaces, BIN with zeros (glTF 2.0 §4.4.3).
+pub(crate) fn glb_bytes(json: &Value, bin: &[u8]) -> Vec<u8> {
+    let mut json_chunk = json.to_string().into_bytes();
+    json_chunk.resize(json_chunk.len().next_multiple_of(4), b' ');
+    let bin_chunk_len = bin.len().next_multiple_of(4);
+    let mut total = GLB_HEADER_BYTES + CHUNK_HEADER_BYTES + json_chunk.len();
+    if !bin.is_empty() {
+        total += CHUNK_HEADER_BYTES + bin_chunk_len;
+    }
+    let mut out = Vec::with_capacity(total);
+    out.extend_from_slice(GLB_MAGIC);
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(json_chunk.len() as u32).to_le_bytes());
+    out.extend_from_slice(&CHUNK_JSON.to_le_bytes());
+    out.extend_from_slice(&json_chunk);
+    if !bin.is_empty() {
+        out.extend_from_slice(&(bin_chunk_len as u32).to_le_bytes());
+        out.extend_from_slice(&CHUNK_BIN.to_le_bytes());
+        out.extend_from_slice(bin);
+        out.resize(total, 0);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn percent_escapes_decode() {
+        assert_eq!(percent_decode("a%20b.bin").unwrap(), "a b.bin");
+        assert!(percent_decode("a%2").is_err());
+    }
+
+    #[test]
+    fn glb_round_trips_through_split() {
+        let json = serde_json::json!({"asset": {"version": "2.0"}});
+        let bytes = glb_bytes(&json, &[1, 2, 3]);
+        assert_eq!(bytes.len() % 4, 0);
+        let (json_bytes, bin) = split_glb(Path::new("x.glb"), &bytes).unwrap();
+        assert_eq!(parse_json(Path::new("x.glb"), json_bytes).unwrap(), json);
+        assert_eq!(&bin.unwrap()[..3], &[1, 2, 3]);
+    }
+}

@@ -1,0 +1,71 @@
+//! glTF 2.0 (`.gltf` with embedded or external buffers, `.glb`) and VRM (a `.glb`):
+//! reading a [`Character`](crate::Character) and writing skinned or debug binaries.
+//!
+//! The document is kept as raw JSON ([`serde_json::Value`]) with its buffers, so that the
+//! writer can replace the skin weights in a copy that preserves everything else
+//! (materials, textures, animations, names, extras, extensions).
+
+mod accessor;
+mod animation;
+mod builder;
+mod container;
+mod debug;
+mod document;
+mod new_document;
+mod nodes;
+mod output;
+mod read;
+mod rewrite;
+mod write;
+
+pub use debug::write_debug_glb;
+pub use read::read;
+pub use write::{write_skinned_glb, WriteOptions};
+
+use serde_json::Value;
+use std::ops::Range;
+
+/// What a character read from glTF keeps of its source, for the writer.
+///
+/// - `document`: the whole JSON document, untouched.
+/// - `buffers`: the bytes of every buffer, in `document.buffers` order.
+/// - `skin`: the skin whose joints are the character's skeleton, if any.
+/// - `primitives`: every primitive read into `Character::mesh`, in mesh order.
+#[derive(Clone)]
+pub struct GltfSource {
+    pub document: Value,
+    pub buffers: Vec<Vec<u8>>,
+    pub skin: Option<usize>,
+    pub primitives: Vec<PrimitiveSource>,
+}
+
+impl std::fmt::Debug for GltfSource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("GltfSource")
+            .field(
+                "buffer_bytes",
+                &self.buffers.iter().map(Vec::len).collect::<Vec<_>>(),
+            )
+            .field("skin", &self.skin)
+            .field("primitives", &self.primitives)
+            .finish_non_exhaustive()
+    }
+}
+
+/// Where a primitive of the document went in `Character::mesh`.
+///
+/// - `mesh`, `primitive`: its index in `meshes` and in that mesh's `primitives`.
+/// - `node`: the node instantiating the mesh (the first one, for a skinned mesh).
+/// - `position_accessor`: its POSITION accessor; primitives sharing it share `vertices`.
+/// - `vertices`: its vertices' range in `Character::mesh.positions` (all the accessor's
+///   vertices, in accessor order).
+/// - `triangles`: its triangles' range in `Character::mesh.triangles`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PrimitiveSource {
+    pub mesh: usize,
+    pub primitive: usize,
+    pub node: usize,
+    pub position_accessor: usize,
+    pub vertices: Range<usize>,
+    pub triangles: Range<usize>,
+}

@@ -1,0 +1,59 @@
+//! Writing an output file safely: never over the input, never half-written.
+
+use crate::IoError;
+use std::path::Path;
+
+/// Writes `bytes` to `out` through a temporary file in the same folder that is then renamed
+/// into place, so `out` is either complete or untouched; the temporary file is removed on
+/// error.
+///
+/// # Errors
+/// [`IoError::WouldOverwriteInput`] when `out` is the file `input` (same path after
+/// resolving links), [`IoError::IsDirectory`] when `out` is a folder, [`IoError::Write`]
+/// when the file cannot be written.
+pub(crate) fn write_atomically(
+    out: &Path,
+    input: Option<&Path>,
+    bytes: &[u8],
+) -> Result<(), IoError> {
+    if input.is_some_and(|input| is_same_file(out, input)) {
+        return Err(IoError::WouldOverwriteInput {
+            path: out.to_path_buf(),
+        });
+    }
+    if out.is_dir() {
+        return Err(IoError::IsDirectory {
+            path: out.to_path_buf(),
+        });
+    }
+    let write_error = |source| IoError::Write {
+        path: out.to_path_buf(),
+        source,
+    };
+    let name = out
+        .file_name()
+        .ok_or_else(|| write_error(std::io::Error::other("the path has no file name")))?;
+    let temporary = out.with_file_name(format!(
+        ".{}.{}.tmp",
+        name.to_string_lossy(),
+        std::process::id()
+    ));
+    let result = std::fs::write(&temporary, bytes).and_then(|()| std::fs::rename(&temporary, out));
+    if let Err(source) = result {
+        // Best effort: the temporary file may not exist if its creation failed.
+        let _ = std::fs::remove_file(&temporary);
+        return Err(write_error(source));
+    }
+    Ok(())
+}
+
+/// True when `a` and `b` name the same file (equal paths, or equal once resolved).
+fn is_same_file(a: &Path, b: &Path) -> bool {
+    if a == b {
+        return true;
+    }
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
+}

@@ -1,0 +1,464 @@
+//! Reading a glTF document into a [`Character`]: the skinned meshes' triangles, the skin's
+//! joints with their bind pose, the stored weights, the node rig and the animations.
+
+use super::accessor::{read_floats, read_uints};
+use super::animation::{read_clips, read_rig};
+use super::container::read_container;
+use super::document::Document;
+use super::nodes::{unique_node_names, NodeTree};
+use super::{GltfSource, PrimitiveSource};
+use crate::{Character, IoError, TriangleMesh};
+use atlas_skin_runtime::{Skeleton, VertexWeights, NO_PARENT};
+use glam::{Mat4, Vec3};
+use serde_json::Value;
+use std::collections::HashMap;
+use std::path::Path;
+
+/// Reads a `.glb`, `.gltf` (embedded or external buffers) or `.vrm` file.
+///
+/// - Skin: the first skin used by a node that also has a mesh. Its meshes' triangle
+///   primitives (TRIANGLES, or strips and fans converted) are concatenated in document
+///   order, positions as stored (the skin's bind space; node transforms are not applied).
+///   Without a skin, every mesh node's triangles are read with the node's world transform
+///   applied, and the character has no skeleton.
+/// - Primitives sharing a POSITION accessor share their vertices in `Character::mesh`.
+/// - Skeleton: the skin's joints in skin order, each joint's parent the nearest ancestor
+///   node that is a joint; names from the nodes (`node<index>` when missing, made unique);
+///   bind pose from `inverseBindMatrices` (identity when absent).
+/// - Reference weights: JOINTS_n/WEIGHTS_n as stored (not renormalised, zeros dropped).
+///
+/// # Errors
+/// [`IoError`] naming the file and the problem for anything malformed: containers,
+/// JSON, out-of-range accessors or indices, non-finite positions, node cycles.
+pub fn read(path: &Path) -> Result<Character, IoError> {
+    let container = read_container(path)?;
+    let doc = Document {
+        json: &container.json,
+        buffers: &container.buffers,
+        path,
+    };
+    reject_compressed_geometry(&doc)?;
+    let tree = NodeTree::new(&doc)?;
+    let skin = find_skin(&doc)?;
+    let joints = match skin {
+        Some(skin) => skin_joints(&doc, skin)?,
+        None => Vec::new(),
+    };
+    let names = unique_node_names(&doc, &joints)?;
+    let mut warnings = Vec::new();
+    let instances = mesh_instances(&doc, &tree, skin)?;
+    let geometry = read_geometry(&doc, &instances, &mut warnings)?;
+    if geometry.mesh.triangles.is_empty() {
+        return Err(doc.error(if skin.is_some() {
+            "the skinned meshes have no triangle primitive"
+        } else {
+            "the document has no mesh node with triangles"
+        }));
+    }
+    let (skeleton, reference_weights) = match skin {
+        Some(skin) => {
+            let joint_names = joints.iter().map(|&n| names[n].clone()).collect();
+            let skeleton = read_skeleton(&doc, &tree, skin, &joints, joint_names)?;
+            let weights = read_reference_weights(&doc, &geometry.blocks, joints.len())?;
+            (Some(skeleton), weights)
+        }
+        None => (None, None),
+    };
+    let rig = read_rig(&tree, names, &joints);
+    let clips = read_clips(&doc, &mut warnings)?;
+    let mut character = Character::new(path, geometry.mesh);
+    character.skeleton = skeleton;
+    character.reference_weights = reference_weights;
+    character.rig = Some(rig);
+    character.clips = clips;
+    character.warnings = warnings;
+    character.gltf = Some(GltfSource {
+        skin,
+        primitives: geometry.primitives,
+        document: container.json,
+        buffers: container.buffers,
+    });
+    Ok(character)
+}
+
+/// Required extensions that store geometry this reader cannot decode (their accessors have
+/// no plain data).
+const COMPRESSED_GEOMETRY: [&str; 2] = ["KHR_draco_mesh_compression", "EXT_meshopt_compression"];
+
+fn reject_compressed_geometry(doc: &Document) -> Result<(), IoError> {
+    for extension in doc.array("extensionsRequired")? {
+        if let Some(name) = extension
+            .as_str()
+            .filter(|n| COMPRESSED_GEOMETRY.contains(n))
+        {
+            return Err(doc.error(format!(
+                "compressed geometry ({name}) is not supported; decompress the file first"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The first skin (in node order) of a node that also has a mesh.
+fn find_skin(doc: &Document) -> Result<Option<usize>, IoError> {
+    let skin_count = doc.array("skins")?.len();
+    for (index, node) in doc.array("nodes")?.iter().enumerate() {
+        let location = format!("nodes[{index}]");
+        let has_mesh = doc.opt_index(node, &location, "mesh")?.is_some();
+        if let (true, Some(skin)) = (has_mesh, doc.opt_index(node, &location, "skin")?) {
+            if skin >= skin_count {
+                return Err(doc.error(format!(
+                    "{location}.skin is {skin} but the document has {skin_count} skins"
+                )));
+            }
+            return Ok(Some(skin));
+        }
+    }
+    Ok(None)
+}
+
+/// The joint node indices of `skin`: non-empty, in range, no node twice.
+fn skin_joints(doc: &Document, skin: usize) -> Result<Vec<usize>, IoError> {
+    let location = format!("skins[{skin}]");
+    let joints = doc.indices(doc.item("skins", skin)?, &location, "joints")?;
+    let node_count = doc.array("nodes")?.len();
+    if joints.is_empty() {
+        return Err(doc.error(format!("{location} has no joints")));
+    }
+    let mut seen = vec![false; node_count];
+    for &node in &joints {
+        if node >= node_count {
+            return Err(doc.error(format!(
+                "{location}.joints has node {node}, but the document has {node_count} nodes"
+            )));
+        }
+        if std::mem::replace(&mut seen[node], true) {
+            return Err(doc.error(format!("{location}.joints lists node {node} twice")));
+        }
+    }
+    Ok(joints)
+}
+
+/// One use of a mesh by a node; `world` is applied to positions (unskinned input only).
+struct MeshInstance {
+    node: usize,
+    mesh: usize,
+    world: Option<Mat4>,
+}
+
+/// With a skin: each mesh used by a node with that skin, once, untransformed. Without:
+/// every mesh node with its world transform.
+fn mesh_instances(
+    doc: &Document,
+    tree: &NodeTree,
+    skin: Option<usize>,
+) -> Result<Vec<MeshInstance>, IoError> {
+    let mesh_count = doc.array("meshes")?.len();
+    let mut instances: Vec<MeshInstance> = Vec::new();
+    for (node, object) in doc.array("nodes")?.iter().enumerate() {
+        let location = format!("nodes[{node}]");
+        let Some(mesh) = doc.opt_index(object, &location, "mesh")? else {
+            continue;
+        };
+        if mesh >= mesh_count {
+            return Err(doc.error(format!(
+                "{location}.mesh is {mesh} but the document has {mesh_count} meshes"
+            )));
+        }
+        match skin {
+            Some(skin) => {
+                let uses_skin = doc.opt_index(object, &location, "skin")? == Some(skin);
+                if uses_skin && !instances.iter().any(|i| i.mesh == mesh) {
+                    instances.push(MeshInstance {
+                        node,
+                        mesh,
+                        world: None,
+                    });
+                }
+            }
+            None => instances.push(MeshInstance {
+                node,
+                mesh,
+                world: Some(tree.world(node)),
+            }),
+        }
+    }
+    if skin.is_some() {
+        // Document order of the meshes, not of the nodes using them.
+        instances.sort_by_key(|i| i.mesh);
+    }
+    Ok(instances)
+}
+
+/// Vertices of one POSITION accessor (per node when a world transform was applied), shared
+/// by the primitives that use it.
+///
+/// - `attributes`: the `attributes` object of the first primitive using them (where the
+///   stored weights are read).
+/// - `first`, `count`: their range in the concatenated mesh.
+struct VertexBlock<'a> {
+    attributes: &'a Value,
+    location: String,
+    first: usize,
+    count: usize,
+}
+
+struct Geometry<'a> {
+    mesh: TriangleMesh,
+    blocks: Vec<VertexBlock<'a>>,
+    primitives: Vec<PrimitiveSource>,
+}
+
+/// glTF primitive modes this reader turns into triangles.
+const TRIANGLES: usize = 4;
+const TRIANGLE_STRIP: usize = 5;
+const TRIANGLE_FAN: usize = 6;
+
+fn read_geometry<'a>(
+    doc: &Document<'a>,
+    instances: &[MeshInstance],
+    warnings: &mut Vec<String>,
+) -> Result<Geometry<'a>, IoError> {
+    let mut mesh = TriangleMesh::default();
+    let mut blocks: Vec<VertexBlock> = Vec::new();
+    let mut block_of: HashMap<(usize, Option<usize>), usize> = HashMap::new();
+    let mut primitives = Vec::new();
+    for instance in instances {
+        let mesh_location = format!("meshes[{}]", instance.mesh);
+        let object = doc.item("meshes", instance.mesh)?;
+        let Some(Value::Array(list)) = object.get("primitives") else {
+            return Err(doc.error(format!("{mesh_location} has no primitives array")));
+        };
+        for (index, primitive) in list.iter().enumerate() {
+            let location = format!("{mesh_location}.primitives[{index}]");
+            let mode = doc
+                .opt_index(primitive, &location, "mode")?
+                .unwrap_or(TRIANGLES);
+            if !matches!(mode, TRIANGLES | TRIANGLE_STRIP | TRIANGLE_FAN) {
+                warnings.push(format!(
+                    "{location} has mode {mode} (points or lines): skipped"
+                ));
+                continue;
+            }
+            let attributes = primitive
+                .get("attributes")
+                .filter(|a| a.is_object())
+                .ok_or_else(|| doc.error(format!("{location} has no attributes object")))?;
+            let position = doc.index(attributes, &format!("{location}.attributes"), "POSITION")?;
+            let key = (position, instance.world.map(|_| instance.node));
+            let block = match block_of.get(&key) {
+                Some(&block) => block,
+                None => {
+                    let first = mesh.positions.len();
+                    let positions = read_positions(doc, position, &location, instance.world)?;
+                    blocks.push(VertexBlock {
+                        attributes,
+                        location: location.clone(),
+                        first,
+                        count: positions.len(),
+                    });
+                    mesh.positions.extend(positions);
+                    block_of.insert(key, blocks.len() - 1);
+                    blocks.len() - 1
+                }
+            };
+            let (first, vertex_count) = (blocks[block].first, blocks[block].count);
+            let indices = match doc.opt_index(primitive, &location, "indices")? {
+                Some(accessor) => {
+                    read_uints(doc, accessor, "SCALAR", &format!("{location}.indices"))?
+                }
+                None => (0..vertex_count as u32).collect(),
+            };
+            if let Some(bad) = indices.iter().find(|&&i| i as usize >= vertex_count) {
+                return Err(doc.error(format!(
+                    "{location}: index {bad} is out of range of its {vertex_count} vertices"
+                )));
+            }
+            let first_triangle = mesh.triangles.len();
+            let offset = first as u32;
+            mesh.triangles.extend(
+                triangles_of(mode, &indices, &location, doc)?
+                    .into_iter()
+                    .map(|t| t.map(|v| v + offset)),
+            );
+            primitives.push(PrimitiveSource {
+                node: instance.node,
+                mesh: instance.mesh,
+                primitive: index,
+                position_accessor: position,
+                vertices: first..first + vertex_count,
+                triangles: first_triangle..mesh.triangles.len(),
+            });
+        }
+    }
+    Ok(Geometry {
+        mesh,
+        blocks,
+        primitives,
+    })
+}
+
+/// Positions of accessor `position` (VEC3), transformed by `world` when given; every
+/// coordinate must be finite.
+fn read_positions(
+    doc: &Document,
+    position: usize,
+    location: &str,
+    world: Option<Mat4>,
+) -> Result<Vec<Vec3>, IoError> {
+    let values = read_floats(doc, position, "VEC3", &format!("{location} POSITION"))?;
+    let mut positions: Vec<Vec3> = values.chunks_exact(3).map(Vec3::from_slice).collect();
+    if let Some(world) = world {
+        for p in &mut positions {
+            *p = world.transform_point3(*p);
+        }
+    }
+    if let Some(bad) = positions.iter().position(|p| !p.is_finite()) {
+        return Err(doc.error(format!(
+            "{location}: POSITION (accessors[{position}]) vertex {bad} is not finite: {}",
+            positions[bad]
+        )));
+    }
+    Ok(positions)
+}
+
+/// Triangles of a primitive of `mode` with vertex `indices`: TRIANGLES as stored; strips
+/// and fans converted (glTF 2.0 §3.7.2.1), skipping the degenerate triangles strips use as
+/// restarts.
+fn triangles_of(
+    mode: usize,
+    indices: &[u32],
+    location: &str,
+    doc: &Document,
+) -> Result<Vec<[u32; 3]>, IoError> {
+    if mode == TRIANGLES {
+        if !indices.len().is_multiple_of(3) {
+            return Err(doc.error(format!(
+                "{location}: {} indices is not a multiple of 3",
+                indices.len()
+            )));
+        }
+        return Ok(indices
+            .chunks_exact(3)
+            .map(|t| [t[0], t[1], t[2]])
+            .collect());
+    }
+    let triangles = (0..indices.len().saturating_sub(2)).map(|i| match mode {
+        TRIANGLE_STRIP if i % 2 == 0 => [indices[i], indices[i + 1], indices[i + 2]],
+        TRIANGLE_STRIP => [indices[i + 1], indices[i], indices[i + 2]],
+        _ => [indices[0], indices[i + 1], indices[i + 2]],
+    });
+    Ok(triangles
+        .filter(|[a, b, c]| a != b && b != c && a != c)
+        .collect())
+}
+
+/// The skeleton of `skin` over its `joints` (node indices).
+fn read_skeleton(
+    doc: &Document,
+    tree: &NodeTree,
+    skin: usize,
+    joints: &[usize],
+    names: Vec<String>,
+) -> Result<Skeleton, IoError> {
+    let location = format!("skins[{skin}]");
+    let object = doc.item("skins", skin)?;
+    let inverse_bind = match doc.opt_index(object, &location, "inverseBindMatrices")? {
+        None => vec![Mat4::IDENTITY; joints.len()],
+        Some(accessor) => {
+            let role = format!("{location}.inverseBindMatrices");
+            let values = read_floats(doc, accessor, "MAT4", &role)?;
+            if values.len() / 16 != joints.len() {
+                return Err(doc.error(format!(
+                    "{location}.inverseBindMatrices has {} matrices for {} joints",
+                    values.len() / 16,
+                    joints.len()
+                )));
+            }
+            values.chunks_exact(16).map(Mat4::from_cols_slice).collect()
+        }
+    };
+    let joint_of: HashMap<usize, u32> = joints
+        .iter()
+        .enumerate()
+        .map(|(j, &node)| (node, j as u32))
+        .collect();
+    let parents = joints
+        .iter()
+        .map(|&node| {
+            let mut current = tree.parents[node];
+            while let Some(ancestor) = current {
+                if let Some(&joint) = joint_of.get(&ancestor) {
+                    return joint;
+                }
+                current = tree.parents[ancestor];
+            }
+            NO_PARENT
+        })
+        .collect();
+    Skeleton::new(names, parents, inverse_bind).map_err(|source| IoError::Skeleton {
+        path: doc.path.to_path_buf(),
+        source,
+    })
+}
+
+/// The stored JOINTS_n/WEIGHTS_n of every vertex block, as stored (zeros dropped); `None`
+/// when no block has JOINTS_0. Blocks without weights get empty rows.
+fn read_reference_weights(
+    doc: &Document,
+    blocks: &[VertexBlock],
+    joint_count: usize,
+) -> Result<Option<VertexWeights>, IoError> {
+    let mut rows: Vec<Vec<(u32, f32)>> = Vec::new();
+    let mut any = false;
+    for block in blocks {
+        let mut block_rows = vec![Vec::new(); block.count];
+        for set in 0.. {
+            let location = format!("{}.attributes", block.location);
+            let joints = doc.opt_index(block.attributes, &location, &format!("JOINTS_{set}"))?;
+            let weights = doc.opt_index(block.attributes, &location, &format!("WEIGHTS_{set}"))?;
+            let (Some(joints), Some(weights)) = (joints, weights) else {
+                break;
+            };
+            any = true;
+            let joints_values =
+                read_uints(doc, joints, "VEC4", &format!("{location}.JOINTS_{set}"))?;
+            let weight_values =
+                read_floats(doc, weights, "VEC4", &format!("{location}.WEIGHTS_{set}"))?;
+            for (name, values) in [
+                ("JOINTS", joints_values.len()),
+                ("WEIGHTS", weight_values.len()),
+            ] {
+                if values != 4 * block.count {
+                    return Err(doc.error(format!(
+                        "{location}: {name}_{set} has {} elements for {} vertices",
+                        values / 4,
+                        block.count
+                    )));
+                }
+            }
+            for (v, row) in block_rows.iter_mut().enumerate() {
+                for k in 4 * v..4 * v + 4 {
+                    let (joint, weight) = (joints_values[k], weight_values[k]);
+                    if !weight.is_finite() || weight < 0.0 {
+                        return Err(doc.error(format!(
+                            "{location}: WEIGHTS_{set} of vertex {v} has weight {weight}"
+                        )));
+                    }
+                    if weight == 0.0 {
+                        continue;
+                    }
+                    if joint as usize >= joint_count {
+                        return Err(doc.error(format!(
+                            "{location}: JOINTS_{set} of vertex {v} is joint {joint}, but the skin \
+                             has {joint_count} joints"
+                        )));
+                    }
+                    row.push((joint, weight));
+                }
+            }
+        }
+        rows.extend(block_rows);
+    }
+    Ok(any.then(|| VertexWeights::from_rows(rows)))
+}

@@ -1,0 +1,214 @@
+//! New skin weights into a copy of the input glTF document, everything else preserved.
+
+use super::animation::append_clips;
+use super::builder::GlbBuilder;
+use super::container::load_uri;
+use super::write::{merge_asset_extras, pack_weights, push_weight_accessors, WriteOptions};
+use super::GltfSource;
+use crate::{Character, IoError};
+use atlas_skin_runtime::VertexWeights;
+use serde_json::{json, Map, Value};
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::Path;
+
+/// The `.glb` bytes of the input document with new weights.
+///
+/// Every bufferView is copied into the single output buffer (its offset keeps its phase
+/// modulo 4, so accessors inside stay aligned); images with a URI are embedded as
+/// bufferViews. For each POSITION accessor read into `character.mesh`, new JOINTS_n and
+/// WEIGHTS_n accessors are made once and put on every primitive of the skinned meshes
+/// using that POSITION accessor; JOINTS_n/WEIGHTS_n sets beyond the new ones are removed.
+/// The old weight accessors stay in the document, unused.
+pub(crate) fn rewrite_document(
+    character: &Character,
+    source: &GltfSource,
+    weights: &VertexWeights,
+    options: &WriteOptions,
+    out: &Path,
+) -> Result<Vec<u8>, IoError> {
+    let input = &character.path;
+    let Value::Object(json) = source.document.clone() else {
+        return Err(IoError::invalid(
+            input,
+            "the glTF document is not a JSON object",
+        ));
+    };
+    let mut builder = GlbBuilder::new(json);
+    copy_buffer_views(&mut builder, source, input)?;
+    embed_images(&mut builder, input)?;
+
+    let joint_nodes = skin_joint_nodes(&source.document, source.skin, input)?;
+    let joint_count = character.skeleton.as_ref().map_or(0, |s| s.len());
+    if joint_count != joint_nodes.len() {
+        return Err(IoError::invalid(
+            out,
+            format!(
+                "the skeleton has {joint_count} joints but the document's skin has {}",
+                joint_nodes.len()
+            ),
+        ));
+    }
+    let mut new_sets: BTreeMap<usize, Vec<(usize, usize)>> = BTreeMap::new();
+    for primitive in &source.primitives {
+        if new_sets.contains_key(&primitive.position_accessor) {
+            continue;
+        }
+        let packed = pack_weights(weights, primitive.vertices.clone(), options.max_influences);
+        let accessors = push_weight_accessors(&mut builder, &packed, joint_count);
+        new_sets.insert(primitive.position_accessor, accessors);
+    }
+    let skinned_meshes: BTreeSet<usize> = source.primitives.iter().map(|p| p.mesh).collect();
+    replace_weight_attributes(builder.json_mut(), &skinned_meshes, &new_sets);
+
+    append_clips(&mut builder, &options.animations, &joint_nodes, out)?;
+    if let Some(extras) = &options.extras {
+        merge_asset_extras(builder.json_mut(), extras);
+    }
+    Ok(builder.finish())
+}
+
+/// Copies every bufferView's bytes into the output buffer and points the view at it.
+fn copy_buffer_views(
+    builder: &mut GlbBuilder,
+    source: &GltfSource,
+    input: &Path,
+) -> Result<(), IoError> {
+    let Some(Value::Array(mut views)) = builder.json_mut().remove("bufferViews") else {
+        return Ok(());
+    };
+    for (index, view) in views.iter_mut().enumerate() {
+        let field = |key: &str| view.get(key).and_then(Value::as_u64).map(|v| v as usize);
+        let (buffer, offset, length) = (
+            field("buffer").unwrap_or(usize::MAX),
+            field("byteOffset").unwrap_or(0),
+            field("byteLength").unwrap_or(0),
+        );
+        let bytes = source
+            .buffers
+            .get(buffer)
+            .and_then(|data| data.get(offset..offset.checked_add(length)?))
+            .ok_or_else(|| {
+                IoError::invalid(
+                    input,
+                    format!("bufferViews[{index}] is out of range of its buffer"),
+                )
+            })?;
+        let new_offset = builder.append_bytes(bytes, offset);
+        view["buffer"] = json!(0);
+        view["byteOffset"] = json!(new_offset);
+    }
+    builder
+        .json_mut()
+        .insert("bufferViews".into(), Value::Array(views));
+    Ok(())
+}
+
+/// Embeds every image given by URI (a file beside the input or a `data:` URI) as a
+/// bufferView with its `mimeType`.
+fn embed_images(builder: &mut GlbBuilder, input: &Path) -> Result<(), IoError> {
+    let Some(Value::Array(mut images)) = builder.json_mut().remove("images") else {
+        return Ok(());
+    };
+    for (index, image) in images.iter_mut().enumerate() {
+        let Some(uri) = image.get("uri").and_then(Value::as_str).map(str::to_string) else {
+            continue;
+        };
+        let (bytes, declared_type) = load_uri(input, &uri)
+            .map_err(|e| IoError::invalid(input, format!("images[{index}]: {e}")))?;
+        let mime_type = sniff_image_type(&bytes)
+            .map(str::to_string)
+            .or_else(|| {
+                image
+                    .get("mimeType")
+                    .and_then(Value::as_str)
+                    .map(str::to_string)
+            })
+            .or(declared_type)
+            .ok_or_else(|| {
+                IoError::invalid(
+                    input,
+                    format!("images[{index}] ({uri}) has an unknown type"),
+                )
+            })?;
+        let view = builder.push_view(&bytes, None);
+        if let Value::Object(image) = image {
+            image.remove("uri");
+            image.insert("bufferView".into(), json!(view));
+            image.insert("mimeType".into(), json!(mime_type));
+        }
+    }
+    builder
+        .json_mut()
+        .insert("images".into(), Value::Array(images));
+    Ok(())
+}
+
+/// The media type of image bytes recognised by their signature.
+fn sniff_image_type(bytes: &[u8]) -> Option<&'static str> {
+    if bytes.starts_with(b"\x89PNG\r\n\x1a\n") {
+        Some("image/png")
+    } else if bytes.starts_with(&[0xFF, 0xD8, 0xFF]) {
+        Some("image/jpeg")
+    } else if bytes.len() >= 12 && &bytes[0..4] == b"RIFF" && &bytes[8..12] == b"WEBP" {
+        Some("image/webp")
+    } else if bytes.starts_with(b"\xABKTX 20\xBB") {
+        Some("image/ktx2")
+    } else {
+        None
+    }
+}
+
+/// On every primitive of `meshes` whose POSITION accessor has new weights: JOINTS_k and
+/// WEIGHTS_k set to the new accessors, and sets beyond them removed.
+fn replace_weight_attributes(
+    json: &mut Map<String, Value>,
+    meshes: &BTreeSet<usize>,
+    new_sets: &BTreeMap<usize, Vec<(usize, usize)>>,
+) {
+    let Some(Value::Array(all_meshes)) = json.get_mut("meshes") else {
+        return;
+    };
+    for &mesh in meshes {
+        let Some(Value::Array(primitives)) = all_meshes
+            .get_mut(mesh)
+            .and_then(|m| m.get_mut("primitives"))
+        else {
+            continue;
+        };
+        for primitive in primitives {
+            let Some(Value::Object(attributes)) = primitive.get_mut("attributes") else {
+                continue;
+            };
+            let position = attributes.get("POSITION").and_then(Value::as_u64);
+            let Some(sets) = position.and_then(|p| new_sets.get(&(p as usize))) else {
+                continue;
+            };
+            attributes.retain(|name, _| {
+                let set = name
+                    .strip_prefix("JOINTS_")
+                    .or_else(|| name.strip_prefix("WEIGHTS_"))
+                    .and_then(|n| n.parse::<usize>().ok());
+                !matches!(set, Some(set) if set >= sets.len())
+            });
+            for (set, &(joints, weights)) in sets.iter().enumerate() {
+                attributes.insert(format!("JOINTS_{set}"), json!(joints));
+                attributes.insert(format!("WEIGHTS_{set}"), json!(weights));
+            }
+        }
+    }
+}
+
+/// Node index of every joint of `skin`.
+fn skin_joint_nodes(
+    document: &Value,
+    skin: Option<usize>,
+    input: &Path,
+) -> Result<Vec<usize>, IoError> {
+    let joints = skin
+        .and_then(|skin| document.get("skins")?.get(skin)?.get("joints")?.as_array())
+        .ok_or_else(|| IoError::invalid(input, "the document's skin has no joints"))?;
+    Ok(joints
+        .iter()
+        .filter_map(|j| j.as_u64().map(|j| j as usize))
+        .collect())
+}

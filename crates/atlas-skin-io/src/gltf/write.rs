@@ -1,0 +1,217 @@
+//! Writing a skinned `.glb`: new weights into a copy of the input document, or a new
+//! document for inputs that were not glTF.
+
+use super::accessor::ComponentType;
+use super::builder::{GlbBuilder, ARRAY_BUFFER};
+use super::new_document::new_document;
+use super::output::write_atomically;
+use super::rewrite::rewrite_document;
+use crate::{Character, IoError};
+use atlas_skin_runtime::{Clip, VertexWeights};
+use serde_json::{Map, Value};
+use std::path::Path;
+
+/// What the skinned writer adds to the document.
+#[derive(Debug, Clone)]
+pub struct WriteOptions {
+    /// Largest number of joints per vertex (4 per JOINTS_n/WEIGHTS_n set; > 4 writes
+    /// JOINTS_1/WEIGHTS_1, ...). At least 1.
+    pub max_influences: usize,
+    /// Extra clips to add; `Track::node` is a skeleton joint index, mapped to the joint's
+    /// node in the output.
+    pub animations: Vec<Clip>,
+    /// JSON put into `asset.extras` (merged key by key when both are objects).
+    pub extras: Option<Value>,
+}
+
+impl Default for WriteOptions {
+    fn default() -> Self {
+        Self {
+            max_influences: 4,
+            animations: Vec::new(),
+            extras: None,
+        }
+    }
+}
+
+/// Writes `character` skinned with `weights` as a glTF binary at `out`.
+///
+/// - `weights`: one row per vertex of `character.mesh`, joint indices into
+///   `character.skeleton`.
+/// - glTF input with a skin: the input document with JOINTS_n/WEIGHTS_n of the skinned
+///   primitives replaced and everything else kept (external buffers and images embedded
+///   into the single BIN chunk). Other input: a new document with the mesh, smooth normals,
+///   joint nodes in the bind pose and a skin.
+/// - Weights per vertex: the `max_influences` largest, normalised in the stored float32
+///   (see [`pack_weights`]); a vertex without any weight is bound fully to joint 0.
+///
+/// # Errors
+/// [`IoError::WouldOverwriteInput`] when `out` is the input file; [`IoError::Invalid`]
+/// when the character has no skeleton, the weights do not match the mesh and skeleton, or
+/// the input document cannot be rewritten; [`IoError::Write`] when writing fails. On error
+/// no file is left at `out`.
+pub fn write_skinned_glb(
+    character: &Character,
+    weights: &VertexWeights,
+    options: &WriteOptions,
+    out: &Path,
+) -> Result<(), IoError> {
+    let skeleton = character.skeleton.as_ref().ok_or_else(|| {
+        IoError::invalid(&character.path, "cannot write a skinned glTF: no skeleton")
+    })?;
+    if options.max_influences == 0 {
+        return Err(IoError::invalid(out, "max_influences must be at least 1"));
+    }
+    if weights.vertex_count() != character.mesh.positions.len() {
+        return Err(IoError::invalid(
+            out,
+            format!(
+                "{} weight rows for {} mesh vertices",
+                weights.vertex_count(),
+                character.mesh.positions.len()
+            ),
+        ));
+    }
+    weights
+        .validate(skeleton.len())
+        .map_err(|e| IoError::invalid(out, format!("bad weights: {e}")))?;
+    let bytes = match character.gltf.as_ref() {
+        Some(source) if source.skin.is_some() => {
+            rewrite_document(character, source, weights, options, out)?
+        }
+        _ => new_document(character, skeleton, weights, options, out)?,
+    };
+    write_atomically(out, Some(&character.path), &bytes)
+}
+
+/// Skin weights packed into glTF's fixed-width JOINTS_n/WEIGHTS_n sets.
+///
+/// - `sets`: number of 4-wide sets.
+/// - `joints`, `weights`: #sets lists of #V × 4 values.
+pub(crate) struct PackedWeights {
+    pub joints: Vec<Vec<u32>>,
+    pub weights: Vec<Vec<f32>>,
+}
+
+/// Packs the rows `vertices` of `weights` into `ceil(max_influences / 4)` sets.
+///
+/// Per vertex: repeated joints merged, zeros dropped, the `max_influences` largest kept
+/// and normalised so that the float32 values stored sum to 1: `w_k = w_k / Σ w` for all but
+/// the last kept weight, which is `1 − Σ_{k<last} w_k` of the stored values, so the
+/// float32 sum is 1 within one rounding (≤ 1e-7). A vertex without any weight is bound
+/// fully to joint 0. Unused slots are joint 0 with weight 0.
+pub(crate) fn pack_weights(
+    weights: &VertexWeights,
+    vertices: impl ExactSizeIterator<Item = usize>,
+    max_influences: usize,
+) -> PackedWeights {
+    let sets = max_influences.div_ceil(4);
+    let vertex_count = vertices.len();
+    let mut joints = vec![vec![0u32; 4 * vertex_count]; sets];
+    let mut packed = vec![vec![0f32; 4 * vertex_count]; sets];
+    let pruned_row = |v: usize| {
+        let mut row: Vec<(u32, f32)> = Vec::new();
+        for (j, w) in weights.row(v) {
+            match row.iter_mut().find(|(k, _)| *k == j) {
+                Some(entry) => entry.1 += w,
+                None => row.push((j, w)),
+            }
+        }
+        row.retain(|&(_, w)| w > 0.0);
+        row.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+        row.truncate(max_influences);
+        row
+    };
+    for (out_vertex, v) in vertices.enumerate() {
+        let mut row = pruned_row(v);
+        if row.is_empty() {
+            row.push((0, 1.0));
+        }
+        let sum: f64 = row.iter().map(|&(_, w)| w as f64).sum();
+        let mut stored_sum = 0.0f64;
+        let last = row.len() - 1;
+        for (k, &(joint, weight)) in row.iter().enumerate() {
+            let value = if k == last {
+                (1.0 - stored_sum).max(0.0) as f32
+            } else {
+                (weight as f64 / sum) as f32
+            };
+            stored_sum += value as f64;
+            let (set, slot) = (k / 4, 4 * out_vertex + k % 4);
+            joints[set][slot] = joint;
+            packed[set][slot] = value;
+        }
+    }
+    PackedWeights {
+        joints,
+        weights: packed,
+    }
+}
+
+/// Appends packed weights as JOINTS/WEIGHTS accessors (joints as UNSIGNED_BYTE below 256
+/// joints, else UNSIGNED_SHORT) and returns the accessor indices per set.
+pub(crate) fn push_weight_accessors(
+    builder: &mut GlbBuilder,
+    packed: &PackedWeights,
+    joint_count: usize,
+) -> Vec<(usize, usize)> {
+    let component = if joint_count <= 256 {
+        ComponentType::U8
+    } else {
+        ComponentType::U16
+    };
+    packed
+        .joints
+        .iter()
+        .zip(&packed.weights)
+        .map(|(joints, weights)| {
+            let j = builder.push_uint_accessor(joints, component, "VEC4", Some(ARRAY_BUFFER));
+            let w = builder.push_f32_accessor(weights, "VEC4", false, Some(ARRAY_BUFFER));
+            (j, w)
+        })
+        .collect()
+}
+
+/// Puts `extras` into `asset.extras`, merging key by key when both are objects.
+pub(crate) fn merge_asset_extras(json: &mut Map<String, Value>, extras: &Value) {
+    let asset = json
+        .entry("asset")
+        .or_insert_with(|| Value::Object(Map::new()));
+    let Value::Object(asset) = asset else {
+        return;
+    };
+    match (asset.get_mut("extras"), extras) {
+        (Some(Value::Object(existing)), Value::Object(new)) => {
+            existing.extend(new.iter().map(|(k, v)| (k.clone(), v.clone())));
+        }
+        _ => {
+            asset.insert("extras".into(), extras.clone());
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn packed_weights_sum_to_one_in_f32() {
+        let weights = VertexWeights::from_rows([
+            vec![(0, 0.1), (1, 0.7), (2, 0.3), (1, 0.1), (3, 0.05), (4, 0.01)],
+            vec![],
+            vec![(2, 1.0 / 3.0), (1, 1.0 / 3.0), (0, 1.0 / 3.0)],
+        ]);
+        let packed = pack_weights(&weights, 0..3, 4);
+        assert_eq!(packed.joints.len(), 1);
+        assert_eq!(&packed.joints[0][0..4], &[1, 2, 0, 3]);
+        assert_eq!(&packed.joints[0][4..8], &[0, 0, 0, 0]);
+        assert_eq!(packed.weights[0][4], 1.0);
+        for v in 0..3 {
+            let sum: f32 = packed.weights[0][4 * v..4 * v + 4].iter().sum();
+            assert!((sum - 1.0).abs() <= 1e-6, "vertex {v} sums to {sum}");
+        }
+        let wide = pack_weights(&weights, [0].into_iter(), 5);
+        assert_eq!(wide.joints.len(), 2);
+        assert_eq!(wide.joints[1][0], 4);
+    }
+}

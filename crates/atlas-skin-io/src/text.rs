@@ -1,0 +1,277 @@
+//! Reading shared by the text formats: whole files, whitespace-separated tokens with line
+//! numbers, numbers with errors that name the file and line, and JSON documents.
+
+use crate::IoError;
+use glam::Vec3;
+use serde::de::DeserializeOwned;
+use std::path::Path;
+use std::str::FromStr;
+
+/// Errors for a path that is missing, unreadable, a directory or an empty file.
+pub(crate) fn check_file(path: &Path) -> Result<(), IoError> {
+    let metadata = std::fs::metadata(path).map_err(|source| IoError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    if metadata.is_dir() {
+        return Err(IoError::IsDirectory {
+            path: path.to_path_buf(),
+        });
+    }
+    if metadata.len() == 0 {
+        return Err(IoError::Empty {
+            path: path.to_path_buf(),
+        });
+    }
+    Ok(())
+}
+
+/// The bytes of `path` (see [`check_file`]).
+pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, IoError> {
+    check_file(path)?;
+    std::fs::read(path).map_err(|source| IoError::Read {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// The text of `path` (see [`read_bytes`]). Bytes that are not UTF-8 become U+FFFD: they
+/// only ever occur in comments of the files seen in practice.
+pub(crate) fn read_text(path: &Path) -> Result<String, IoError> {
+    let bytes = read_bytes(path)?;
+    Ok(match String::from_utf8(bytes) {
+        Ok(text) => text,
+        Err(error) => String::from_utf8_lossy(error.as_bytes()).into_owned(),
+    })
+}
+
+/// Parses the JSON document at `path` into `T`; syntax and shape errors carry the line.
+pub(crate) fn read_json<T: DeserializeOwned>(path: &Path) -> Result<T, IoError> {
+    let text = read_text(path)?;
+    serde_json::from_str(&text).map_err(|error| {
+        // serde_json appends " at line L column C"; the line goes into the error instead.
+        let message = error.to_string();
+        let message = match message.rfind(" at line ") {
+            Some(at) => message[..at].to_string(),
+            None => message,
+        };
+        IoError::syntax(path, error.line().max(1), message)
+    })
+}
+
+/// Parses `token` as a `T`, or says which `what` was expected at `line`.
+pub(crate) fn parse_field<T: FromStr>(
+    path: &Path,
+    line: usize,
+    token: Option<&str>,
+    what: &str,
+) -> Result<T, IoError> {
+    let token = token.ok_or_else(|| IoError::syntax(path, line, format!("missing {what}")))?;
+    token.parse().map_err(|_| {
+        IoError::syntax(
+            path,
+            line,
+            format!("{what} {token:?} is not a valid number"),
+        )
+    })
+}
+
+/// Parses `token` as a finite f32 coordinate (NaN and infinities are errors).
+pub(crate) fn parse_finite(
+    path: &Path,
+    line: usize,
+    token: Option<&str>,
+    what: &str,
+) -> Result<f32, IoError> {
+    let value: f32 = parse_field(path, line, token, what)?;
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(IoError::syntax(
+            path,
+            line,
+            format!("{what} is {value}, not a finite number"),
+        ))
+    }
+}
+
+/// Parses the next three tokens as a finite point.
+pub(crate) fn parse_point<'a>(
+    path: &Path,
+    line: usize,
+    tokens: &mut impl Iterator<Item = &'a str>,
+) -> Result<Vec3, IoError> {
+    let x = parse_finite(path, line, tokens.next(), "x coordinate")?;
+    let y = parse_finite(path, line, tokens.next(), "y coordinate")?;
+    let z = parse_finite(path, line, tokens.next(), "z coordinate")?;
+    Ok(Vec3::new(x, y, z))
+}
+
+/// Checks an `index` as written in a file whose first valid index is `first` (0 or 1)
+/// against `count` items, and returns it 0-based.
+pub(crate) fn check_index(
+    path: &Path,
+    line: usize,
+    index: i64,
+    first: i64,
+    count: usize,
+    what: &str,
+) -> Result<u32, IoError> {
+    let zero_based = index - first;
+    if zero_based >= 0 && (zero_based as u64) < count as u64 && zero_based < i64::from(u32::MAX) {
+        Ok(zero_based as u32)
+    } else {
+        Err(IoError::syntax(
+            path,
+            line,
+            format!("{what} index {index} is out of range ({count} defined)"),
+        ))
+    }
+}
+
+/// Whitespace-separated tokens of a text file with the line each came from, skipping
+/// comments that start with `comment`.
+pub(crate) struct Tokens<'a> {
+    path: &'a Path,
+    lines: std::iter::Enumerate<std::str::Lines<'a>>,
+    current: std::str::SplitWhitespace<'a>,
+    line: usize,
+    comment: Option<char>,
+}
+
+impl<'a> Tokens<'a> {
+    pub(crate) fn new(path: &'a Path, text: &'a str, comment: Option<char>) -> Self {
+        Self {
+            path,
+            lines: text.lines().enumerate(),
+            current: "".split_whitespace(),
+            line: 0,
+            comment,
+        }
+    }
+
+    /// The file being read.
+    pub(crate) fn path(&self) -> &'a Path {
+        self.path
+    }
+
+    /// 1-based line of the last token returned.
+    pub(crate) fn line(&self) -> usize {
+        self.line
+    }
+
+    /// A syntax error at the current line.
+    pub(crate) fn error(&self, message: impl Into<String>) -> IoError {
+        IoError::syntax(self.path, self.line.max(1), message)
+    }
+
+    /// The next token, `None` at the end of the file.
+    pub(crate) fn next_token(&mut self) -> Option<&'a str> {
+        loop {
+            if let Some(token) = self.current.next() {
+                return Some(token);
+            }
+            let (index, line) = self.lines.next()?;
+            self.line = index + 1;
+            let content = match self.comment.and_then(|c| line.find(c)) {
+                Some(at) => &line[..at],
+                None => line,
+            };
+            self.current = content.split_whitespace();
+        }
+    }
+
+    /// The next token, or an error naming the `what` that was expected.
+    pub(crate) fn word(&mut self, what: &str) -> Result<&'a str, IoError> {
+        self.next_token()
+            .ok_or_else(|| self.error(format!("unexpected end of file, expected {what}")))
+    }
+
+    /// The next token parsed as a `T`.
+    pub(crate) fn parse<T: FromStr>(&mut self, what: &str) -> Result<T, IoError> {
+        let token = self.word(what)?;
+        parse_field(self.path, self.line, Some(token), what)
+    }
+
+    /// The next token as a finite f32.
+    pub(crate) fn finite(&mut self, what: &str) -> Result<f32, IoError> {
+        let token = self.word(what)?;
+        parse_finite(self.path, self.line, Some(token), what)
+    }
+
+    /// The next three tokens as a finite point.
+    pub(crate) fn point(&mut self) -> Result<Vec3, IoError> {
+        Ok(Vec3::new(
+            self.finite("x coordinate")?,
+            self.finite("y coordinate")?,
+            self.finite("z coordinate")?,
+        ))
+    }
+
+    /// The next token, which must be `keyword` (compared without case).
+    pub(crate) fn expect(&mut self, keyword: &str) -> Result<(), IoError> {
+        let token = self.word(keyword)?;
+        if token.eq_ignore_ascii_case(keyword) {
+            Ok(())
+        } else {
+            Err(self.error(format!("expected {keyword:?}, found {token:?}")))
+        }
+    }
+}
+
+/// Writes `contents` to a fresh file `name` in this process's scratch folder (unit tests).
+#[cfg(test)]
+pub(crate) fn scratch_file(name: &str, contents: impl AsRef<[u8]>) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("atlas-skin-io-unit-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("scratch folder");
+    let path = dir.join(name);
+    std::fs::write(&path, contents).expect("scratch file");
+    path
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tokens_skip_comments_and_track_lines() {
+        let path = Path::new("t.txt");
+        let mut tokens = Tokens::new(path, "a # b c\n\n  1.5 nan\n", Some('#'));
+        assert_eq!(tokens.word("a").unwrap(), "a");
+        assert_eq!(tokens.line(), 1);
+        assert_eq!(tokens.finite("x").unwrap(), 1.5);
+        assert_eq!(tokens.line(), 3);
+        let error = tokens.finite("y").unwrap_err().to_string();
+        assert!(
+            error.starts_with("t.txt:3:") && error.contains("not a finite"),
+            "{error}"
+        );
+        let error = tokens.word("z").unwrap_err().to_string();
+        assert!(
+            error.contains("unexpected end of file, expected z"),
+            "{error}"
+        );
+    }
+
+    #[test]
+    fn fields_and_indices_report_their_line() {
+        let path = Path::new("f.obj");
+        let error = parse_field::<u32>(path, 7, Some("x1"), "index").unwrap_err();
+        assert_eq!(
+            error.to_string(),
+            "f.obj:7: index \"x1\" is not a valid number"
+        );
+        let error = check_index(path, 2, 4, 1, 3, "vertex")
+            .unwrap_err()
+            .to_string();
+        assert_eq!(error, "f.obj:2: vertex index 4 is out of range (3 defined)");
+        assert!(check_index(path, 2, 0, 1, 3, "vertex").is_err());
+        assert_eq!(check_index(path, 2, 3, 1, 3, "vertex").unwrap(), 2);
+        assert_eq!(check_index(path, 2, 0, 0, 3, "vertex").unwrap(), 0);
+        let mut tokens = "1 2".split_whitespace();
+        assert!(parse_point(path, 1, &mut tokens)
+            .unwrap_err()
+            .to_string()
+            .contains("missing z"));
+    }
+}

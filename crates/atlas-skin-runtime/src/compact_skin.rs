@@ -1,0 +1,151 @@
+//! Skin data laid out for the hot loop: a fixed number K of influences per vertex.
+
+use crate::{RuntimeError, VertexWeights};
+
+/// Per-vertex joint indices and weights with the same influence count K for every vertex,
+/// built once from [`VertexWeights`] and validated then, so that skinning trusts it
+/// (ozz-animation's SkinningJob layout).
+///
+/// - `joints`: #V × K joint indices, vertex-major; vertex v's influences are sorted by
+///   decreasing weight, so the first one is the largest (the reference of the dual
+///   quaternion sign fix). Rows with fewer than K influences are padded with their first
+///   joint at weight 0.
+/// - `weights`: #V × (K − 1) weights; the last influence's weight is implicit,
+///   `ω_K = 1 − Σ_{i<K} ω_i` (rows sum to 1), which saves bandwidth and makes an identity
+///   palette reproduce the rest positions bit for bit (the blended matrix's diagonal
+///   rounds to exactly 1).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CompactSkin {
+    influences: usize,
+    joint_count: usize,
+    joints: Vec<u16>,
+    weights: Vec<f32>,
+}
+
+impl CompactSkin {
+    /// Keeps the `max_influences` largest weights of every vertex, rescales each row to
+    /// sum to 1 ([`VertexWeights::pruned`]) and lays them out with K = the largest
+    /// remaining row length.
+    ///
+    /// Errors: the weights' own validation ([`VertexWeights::validate`] against
+    /// `joint_count`), [`RuntimeError::TooManyJoints`] beyond 65536 joints,
+    /// [`RuntimeError::UnweightedVertex`] for a vertex without a positive weight.
+    pub fn new(
+        weights: &VertexWeights,
+        joint_count: usize,
+        max_influences: usize,
+    ) -> Result<Self, RuntimeError> {
+        weights.validate(joint_count)?;
+        if joint_count > usize::from(u16::MAX) + 1 {
+            return Err(RuntimeError::TooManyJoints { count: joint_count });
+        }
+        let pruned = weights.pruned(max_influences.max(1));
+        let influences = pruned.max_influences().max(1);
+        let vertex_count = pruned.vertex_count();
+        let mut skin = Self {
+            influences,
+            joint_count,
+            joints: Vec::with_capacity(vertex_count * influences),
+            weights: Vec::with_capacity(vertex_count * (influences - 1)),
+        };
+        for v in 0..vertex_count {
+            let mut row = pruned.row(v).peekable();
+            let &(first, _) = row
+                .peek()
+                .ok_or(RuntimeError::UnweightedVertex { vertex: v })?;
+            let padded = row.chain(std::iter::repeat((first, 0.0))).take(influences);
+            for (i, (joint, weight)) in padded.enumerate() {
+                // `validate` bounded the joint count to u16 above.
+                skin.joints.push(joint as u16);
+                if i + 1 < influences {
+                    skin.weights.push(weight);
+                }
+            }
+        }
+        Ok(skin)
+    }
+
+    /// K: influences stored per vertex.
+    pub fn influences(&self) -> usize {
+        self.influences
+    }
+
+    /// Number of joints the indices refer to (the palette length a job needs).
+    pub fn joint_count(&self) -> usize {
+        self.joint_count
+    }
+
+    /// Number of vertices.
+    pub fn vertex_count(&self) -> usize {
+        self.joints.len() / self.influences
+    }
+
+    /// #V × K joint indices.
+    pub fn joints(&self) -> &[u16] {
+        &self.joints
+    }
+
+    /// #V × (K − 1) explicit weights.
+    pub fn weights(&self) -> &[f32] {
+        &self.weights
+    }
+
+    /// The rows as [`VertexWeights`] (padding dropped, implicit weights written out): what
+    /// the scalar reference in [`crate::reference`] needs to reproduce this skin.
+    pub fn to_vertex_weights(&self) -> VertexWeights {
+        let k = self.influences;
+        VertexWeights::from_rows((0..self.vertex_count()).map(|v| {
+            let joints = &self.joints[v * k..(v + 1) * k];
+            let explicit = &self.weights[v * (k - 1)..(v + 1) * (k - 1)];
+            let last = 1.0 - explicit.iter().sum::<f32>();
+            joints
+                .iter()
+                .zip(explicit.iter().chain([last].iter()))
+                .filter(|&(_, &w)| w > 0.0)
+                .map(|(&j, &w)| (u32::from(j), w))
+                .collect::<Vec<_>>()
+        }))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn invalid_weights_are_rejected() {
+        let cases = [
+            (VertexWeights::from_rows([vec![(5, 1.0)]]), 2),
+            (VertexWeights::from_rows([vec![(0, -1.0)]]), 2),
+            (VertexWeights::from_rows([vec![(0, f32::NAN)]]), 2),
+            (VertexWeights::from_rows([vec![(0, 1.0)], vec![]]), 2),
+            (VertexWeights::from_rows([vec![(0, 0.0)]]), 2),
+            (VertexWeights::from_rows([vec![(0, 1.0)]]), 70_000),
+        ];
+        for (weights, joints) in cases {
+            assert!(
+                CompactSkin::new(&weights, joints, 4).is_err(),
+                "accepted {weights:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn rows_are_sorted_padded_and_normalised() {
+        let weights = VertexWeights::from_rows([
+            vec![(2, 1.0), (0, 3.0)],
+            vec![(1, 2.0)],
+            vec![(0, 1.0), (1, 1.0), (2, 1.0), (3, 5.0), (4, 1.0)],
+        ]);
+        let skin = CompactSkin::new(&weights, 5, 4).unwrap();
+        assert_eq!(skin.influences(), 4);
+        assert_eq!(skin.vertex_count(), 3);
+        assert_eq!(&skin.joints()[..8], &[0, 2, 0, 0, 1, 1, 1, 1]);
+        assert_eq!(&skin.weights()[..6], &[0.75, 0.25, 0.0, 1.0, 0.0, 0.0]);
+        let back = skin.to_vertex_weights();
+        assert_eq!(back.row(1).collect::<Vec<_>>(), vec![(1, 1.0)]);
+        let row: Vec<_> = back.row(2).collect();
+        assert_eq!(row.len(), 4);
+        assert_eq!(row[0], (3, 5.0 / 8.0));
+    }
+}

@@ -1,0 +1,482 @@
+//! Deforming a mesh by a palette: linear blend and dual quaternion skinning over
+//! caller-owned buffers (the shape of ozz-animation's SkinningJob).
+
+use crate::compact_skin::CompactSkin;
+use crate::dual_quaternion::DualQuat;
+use crate::skinning_palette::{SkinningMethod, SkinningPalette};
+use crate::RuntimeError;
+use glam::{Mat4, Quat, Vec3, Vec4};
+
+/// Vertices per task when running on the rayon pool: large enough to amortise a task,
+/// small enough (≈ 200 KB of streams) to balance two to a few dozen threads.
+pub const PARALLEL_CHUNK: usize = 4096;
+
+/// The sign bit of an IEEE 754 single.
+const SIGN_BIT: u32 = 0x8000_0000;
+
+/// Where a job runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Threading {
+    /// On the calling thread only.
+    #[default]
+    Sequential,
+    /// Split into chunks of [`PARALLEL_CHUNK`] vertices on the current rayon thread pool
+    /// (use `ThreadPool::install` to choose the thread count).
+    Parallel,
+}
+
+/// One skinning pass: reads the rest streams, writes the posed streams.
+///
+/// - `skin`: the weights, #V vertices over #J joints.
+/// - `palette`: #J prepared matrices; its [`SkinningPalette::method`] chooses the blend.
+/// - `rest_positions`, `out_positions`: #V bind-space and posed positions.
+/// - `rest_normals`, `out_normals`: #V unit normals, both present or both absent.
+/// - `rest_tangents`, `out_tangents`: #V tangents (xyz, w = handedness, copied), both
+///   present or both absent.
+///
+/// Positions: LBS `p' = (Σ_i ω_i M_i) p`; DQS `p' = q̂(p)` with `q̂ = b̂ / ‖b̂‖`,
+/// `b̂ = Σ_i ±ω_i q̂_i` (Kavan et al. 2007 §4, sign fix against the vertex's first, largest
+/// influence). Normals and tangents: LBS by the blended matrix's linear part, not
+/// renormalised (as ozz-animation: exact for rigid and uniformly scaled palettes; a
+/// renderer normalises); DQS by the blended rotation (unit in, unit out).
+///
+/// [`SkinningJob::run`] checks only buffer lengths (O(1)); the skin and the palette were
+/// validated when built, and the loop then trusts them and allocates nothing.
+///
+/// The loop is specialised per influence count and stream set; on x86-64 CPUs with AVX2
+/// and FMA (detected at run time) it uses those instructions, elsewhere portable glam
+/// code; both do the same arithmetic in the same order.
+#[derive(Debug)]
+pub struct SkinningJob<'a> {
+    pub skin: &'a CompactSkin,
+    pub palette: &'a SkinningPalette,
+    pub threading: Threading,
+    pub rest_positions: &'a [Vec3],
+    pub rest_normals: Option<&'a [Vec3]>,
+    pub rest_tangents: Option<&'a [Vec4]>,
+    pub out_positions: &'a mut [Vec3],
+    pub out_normals: Option<&'a mut [Vec3]>,
+    pub out_tangents: Option<&'a mut [Vec4]>,
+}
+
+impl SkinningJob<'_> {
+    /// Checks that every stream has the skin's #V elements, that optional streams come in
+    /// (rest, out) pairs, and that the palette has the skin's #J joints.
+    pub fn validate(&self) -> Result<(), RuntimeError> {
+        let vertices = self.skin.vertex_count();
+        let mismatch = |what: String| Err(RuntimeError::BufferSize { what });
+        if self.palette.len() != self.skin.joint_count() {
+            return mismatch(format!(
+                "palette has {} joints, the skin {}",
+                self.palette.len(),
+                self.skin.joint_count()
+            ));
+        }
+        let lengths = [
+            ("rest positions", Some(self.rest_positions.len())),
+            ("out positions", Some(self.out_positions.len())),
+            ("rest normals", self.rest_normals.map(<[Vec3]>::len)),
+            (
+                "out normals",
+                self.out_normals.as_deref().map(<[Vec3]>::len),
+            ),
+            ("rest tangents", self.rest_tangents.map(<[Vec4]>::len)),
+            (
+                "out tangents",
+                self.out_tangents.as_deref().map(<[Vec4]>::len),
+            ),
+        ];
+        for (name, len) in lengths {
+            if let Some(len) = len.filter(|&len| len != vertices) {
+                return mismatch(format!("{name}: {len}, the skin has {vertices} vertices"));
+            }
+        }
+        if self.rest_normals.is_some() != self.out_normals.is_some() {
+            return mismatch("normals must be given both as input and output".into());
+        }
+        if self.rest_tangents.is_some() != self.out_tangents.is_some() {
+            return mismatch("tangents must be given both as input and output".into());
+        }
+        Ok(())
+    }
+
+    /// Validates, then deforms every vertex into the output buffers.
+    pub fn run(&mut self) -> Result<(), RuntimeError> {
+        self.validate()?;
+        let span = Span {
+            joints: self.skin.joints(),
+            weights: self.skin.weights(),
+            rest_positions: self.rest_positions,
+            rest_normals: self.rest_normals.unwrap_or_default(),
+            rest_tangents: self.rest_tangents.unwrap_or_default(),
+            out_positions: self.out_positions,
+            out_normals: self.out_normals.as_deref_mut().unwrap_or_default(),
+            out_tangents: self.out_tangents.as_deref_mut().unwrap_or_default(),
+        };
+        let k = self.skin.influences();
+        let threading = self.threading;
+        match self.palette.method() {
+            SkinningMethod::LinearBlend => {
+                dispatch(self.palette.matrices(), k, threading, span);
+            }
+            SkinningMethod::DualQuaternion => {
+                dispatch(self.palette.dual_quaternions(), k, threading, span);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A blend of per-joint transforms into one per-vertex transform, and how that transform
+/// moves points and directions.
+trait Blend: Copy + Send + Sync {
+    type Transform;
+    /// Blends the transforms of `joints` with weights `explicit` (#joints − 1 of them; the
+    /// last is `1 − Σ explicit`).
+    fn blend(palette: &[Self], joints: &[u16], explicit: &[f32]) -> Self::Transform;
+    fn point(t: &Self::Transform, p: Vec3) -> Vec3;
+    fn vector(t: &Self::Transform, v: Vec3) -> Vec3;
+    /// A loop using this CPU's vector instructions, when there is one.
+    fn simd_kernel(k: usize, normals: bool, tangents: bool) -> Option<Kernel<Self>>;
+}
+
+impl Blend for Mat4 {
+    type Transform = Mat4;
+
+    /// `Σ_i ω_i M_i`. Accumulating the implicit last weight after the explicit ones makes
+    /// an identity palette give a diagonal of exactly 1 (the sum `S + fl(1 − S)` rounds to
+    /// 1 for every `S` in [0, 1]).
+    #[inline(always)]
+    fn blend(palette: &[Self], joints: &[u16], explicit: &[f32]) -> Mat4 {
+        let last = joints.len() - 1;
+        let mut sum = 0.0;
+        let mut blended = Mat4::ZERO;
+        for (&joint, &w) in joints[..last].iter().zip(explicit) {
+            blended += palette[usize::from(joint)] * w;
+            sum += w;
+        }
+        blended + palette[usize::from(joints[last])] * (1.0 - sum)
+    }
+
+    #[inline(always)]
+    fn point(m: &Mat4, p: Vec3) -> Vec3 {
+        m.transform_point3(p)
+    }
+
+    #[inline(always)]
+    fn vector(m: &Mat4, v: Vec3) -> Vec3 {
+        m.transform_vector3(v)
+    }
+
+    fn simd_kernel(k: usize, normals: bool, tangents: bool) -> Option<Kernel<Self>> {
+        #[cfg(target_arch = "x86_64")]
+        return crate::skinning_avx2::linear_blend_kernel(k, normals, tangents);
+        #[cfg(not(target_arch = "x86_64"))]
+        return None;
+    }
+}
+
+impl Blend for DualQuat {
+    type Transform = Mat4;
+
+    /// `b̂ / ‖b̂‖`, `b̂ = Σ_i s_i ω_i q̂_i`, `s_i = sign(real(q̂_i) · real(q̂_0))`, as the
+    /// matrix of its rotation and translation: transforming a point and a normal by a
+    /// matrix costs less than two quaternion rotations (Kavan et al. 2007 §4 do the same
+    /// on the GPU).
+    #[inline(always)]
+    fn blend(palette: &[Self], joints: &[u16], explicit: &[f32]) -> Mat4 {
+        let last = joints.len() - 1;
+        let first = palette[usize::from(joints[0])].real;
+        let mut real = Quat::from_xyzw(0.0, 0.0, 0.0, 0.0);
+        let mut dual = real;
+        let mut add = |joint: u16, w: f32| {
+            let q = palette[usize::from(joint)];
+            // w with the sign of the dot product, without a branch: neighbouring joints
+            // of a random pose flip signs unpredictably.
+            let sign_bit = q.real.dot(first).to_bits() & SIGN_BIT;
+            let signed = f32::from_bits(w.to_bits() ^ sign_bit);
+            real += q.real * signed;
+            dual += q.dual * signed;
+        };
+        let mut sum = 0.0;
+        for (&joint, &w) in joints[..last].iter().zip(explicit) {
+            add(joint, w);
+            sum += w;
+        }
+        add(joints[last], 1.0 - sum);
+        DualQuat { real, dual }.normalized_matrix()
+    }
+
+    #[inline(always)]
+    fn point(m: &Mat4, p: Vec3) -> Vec3 {
+        m.transform_point3(p)
+    }
+
+    #[inline(always)]
+    fn vector(m: &Mat4, v: Vec3) -> Vec3 {
+        m.transform_vector3(v)
+    }
+
+    fn simd_kernel(k: usize, normals: bool, tangents: bool) -> Option<Kernel<Self>> {
+        #[cfg(target_arch = "x86_64")]
+        return crate::skinning_avx2::dual_quaternion_kernel(k, normals, tangents);
+        #[cfg(not(target_arch = "x86_64"))]
+        return None;
+    }
+}
+
+/// A contiguous range of vertices: its slice of every stream. Absent optional streams are
+/// empty slices.
+pub(crate) struct Span<'a> {
+    pub(crate) joints: &'a [u16],
+    pub(crate) weights: &'a [f32],
+    pub(crate) rest_positions: &'a [Vec3],
+    pub(crate) rest_normals: &'a [Vec3],
+    pub(crate) rest_tangents: &'a [Vec4],
+    pub(crate) out_positions: &'a mut [Vec3],
+    pub(crate) out_normals: &'a mut [Vec3],
+    pub(crate) out_tangents: &'a mut [Vec4],
+}
+
+impl<'a> Span<'a> {
+    pub(crate) fn len(&self) -> usize {
+        self.out_positions.len()
+    }
+
+    /// The first `mid` vertices and the rest (`k` influences per vertex).
+    fn split_at(self, mid: usize, k: usize) -> (Span<'a>, Span<'a>) {
+        fn cut<T>(s: &[T], at: usize) -> (&[T], &[T]) {
+            s.split_at(at.min(s.len()))
+        }
+        fn cut_mut<T>(s: &mut [T], at: usize) -> (&mut [T], &mut [T]) {
+            let at = at.min(s.len());
+            s.split_at_mut(at)
+        }
+        let (joints_a, joints_b) = cut(self.joints, mid * k);
+        let (weights_a, weights_b) = cut(self.weights, mid * (k - 1));
+        let (rest_p_a, rest_p_b) = cut(self.rest_positions, mid);
+        let (rest_n_a, rest_n_b) = cut(self.rest_normals, mid);
+        let (rest_t_a, rest_t_b) = cut(self.rest_tangents, mid);
+        let (out_p_a, out_p_b) = cut_mut(self.out_positions, mid);
+        let (out_n_a, out_n_b) = cut_mut(self.out_normals, mid);
+        let (out_t_a, out_t_b) = cut_mut(self.out_tangents, mid);
+        (
+            Span {
+                joints: joints_a,
+                weights: weights_a,
+                rest_positions: rest_p_a,
+                rest_normals: rest_n_a,
+                rest_tangents: rest_t_a,
+                out_positions: out_p_a,
+                out_normals: out_n_a,
+                out_tangents: out_t_a,
+            },
+            Span {
+                joints: joints_b,
+                weights: weights_b,
+                rest_positions: rest_p_b,
+                rest_normals: rest_n_b,
+                rest_tangents: rest_t_b,
+                out_positions: out_p_b,
+                out_normals: out_n_b,
+                out_tangents: out_t_b,
+            },
+        )
+    }
+}
+
+/// A loop over a span: palette, influences per vertex, the span.
+pub(crate) type Kernel<B> = fn(&[B], usize, Span);
+
+/// The loop `$kernel::<[$ty,] K, NORMALS, TANGENTS>` specialised for the influence count
+/// `$k` (1, 2, 3, 4, or 0 for any other count read at run time) and the optional streams
+/// present, as ozz-animation specialises its SkinningJob.
+macro_rules! specialise {
+    ($kernel:ident $(, $ty:ty)?; $k:expr, $normals:expr, $tangents:expr) => {
+        match ($k, $normals, $tangents) {
+            (1, false, _) => $kernel::<$($ty,)? 1, false, false> as $crate::skinning_job::Kernel<_>,
+            (1, true, false) => $kernel::<$($ty,)? 1, true, false>,
+            (1, true, true) => $kernel::<$($ty,)? 1, true, true>,
+            (2, false, _) => $kernel::<$($ty,)? 2, false, false>,
+            (2, true, false) => $kernel::<$($ty,)? 2, true, false>,
+            (2, true, true) => $kernel::<$($ty,)? 2, true, true>,
+            (3, false, _) => $kernel::<$($ty,)? 3, false, false>,
+            (3, true, false) => $kernel::<$($ty,)? 3, true, false>,
+            (3, true, true) => $kernel::<$($ty,)? 3, true, true>,
+            (4, false, _) => $kernel::<$($ty,)? 4, false, false>,
+            (4, true, false) => $kernel::<$($ty,)? 4, true, false>,
+            (4, true, true) => $kernel::<$($ty,)? 4, true, true>,
+            (_, false, _) => $kernel::<$($ty,)? 0, false, false>,
+            (_, true, false) => $kernel::<$($ty,)? 0, true, false>,
+            (_, true, true) => $kernel::<$($ty,)? 0, true, true>,
+        }
+    };
+}
+pub(crate) use specialise;
+
+/// Picks the loop for the influence count and streams: the CPU's vector loop when there
+/// is one, else the portable loop ([`skin_span`]).
+fn dispatch<B: Blend>(palette: &[B], k: usize, threading: Threading, span: Span) {
+    let normals = !span.out_normals.is_empty();
+    let tangents = !span.out_tangents.is_empty();
+    let kernel = B::simd_kernel(k, normals, tangents)
+        .unwrap_or_else(|| portable_kernel::<B>(k, normals, tangents));
+    match threading {
+        Threading::Sequential => kernel(palette, k, span),
+        Threading::Parallel => run_parallel(palette, k, span, kernel),
+    }
+}
+
+/// The portable loop for the influence count and streams.
+fn portable_kernel<B: Blend>(k: usize, normals: bool, tangents: bool) -> Kernel<B> {
+    specialise!(skin_span, B; k, normals, tangents)
+}
+
+/// Halves the span until it has at most [`PARALLEL_CHUNK`] vertices, running the halves
+/// with `rayon::join` (work stealing balances the chunks; nothing is allocated).
+fn run_parallel<B: Blend>(palette: &[B], k: usize, span: Span, kernel: Kernel<B>) {
+    if span.len() <= PARALLEL_CHUNK {
+        kernel(palette, k, span);
+        return;
+    }
+    let chunks = span.len().div_ceil(PARALLEL_CHUNK);
+    let (a, b) = span.split_at(chunks / 2 * PARALLEL_CHUNK, k);
+    rayon::join(
+        || run_parallel(palette, k, a, kernel),
+        || run_parallel(palette, k, b, kernel),
+    );
+}
+
+/// The hot loop. `K` is the influence count, or 0 for "read `k`"; `NORMALS` and
+/// `TANGENTS` say which optional streams exist. Trusts the validated lengths.
+#[inline(never)]
+fn skin_span<B: Blend, const K: usize, const NORMALS: bool, const TANGENTS: bool>(
+    palette: &[B],
+    k: usize,
+    span: Span,
+) {
+    let k = if K == 0 { k } else { K };
+    let joint_rows = span.joints.chunks_exact(k);
+    let explicit_len = k - 1;
+    for (v, joints) in joint_rows.enumerate() {
+        let explicit = &span.weights[v * explicit_len..(v + 1) * explicit_len];
+        let transform = B::blend(palette, joints, explicit);
+        span.out_positions[v] = B::point(&transform, span.rest_positions[v]);
+        if NORMALS {
+            span.out_normals[v] = B::vector(&transform, span.rest_normals[v]);
+        }
+        if TANGENTS {
+            let t = span.rest_tangents[v];
+            span.out_tangents[v] = B::vector(&transform, t.truncate()).extend(t.w);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::random_pose::{random_rotations, SplitMix64};
+    use crate::VertexWeights;
+
+    /// Runs the portable loop directly on every stream.
+    fn run_portable<B: Blend>(
+        palette: &[B],
+        skin: &CompactSkin,
+        rest: &[Vec3],
+        tangents: &[Vec4],
+    ) -> (Vec<Vec3>, Vec<Vec3>, Vec<Vec4>) {
+        let n = rest.len();
+        let (mut p, mut nn, mut t) = (
+            vec![Vec3::ZERO; n],
+            vec![Vec3::ZERO; n],
+            vec![Vec4::ZERO; n],
+        );
+        let span = Span {
+            joints: skin.joints(),
+            weights: skin.weights(),
+            rest_positions: rest,
+            rest_normals: rest,
+            rest_tangents: tangents,
+            out_positions: &mut p,
+            out_normals: &mut nn,
+            out_tangents: &mut t,
+        };
+        portable_kernel::<B>(skin.influences(), true, true)(palette, skin.influences(), span);
+        (p, nn, t)
+    }
+
+    /// The CPU's vector loops (when present) and the portable loops agree to round-off
+    /// for every influence count and both methods.
+    #[test]
+    fn vector_and_portable_loops_agree() {
+        let mut rng = SplitMix64::new(11);
+        let joints = 9;
+        let rest: Vec<Vec3> = (0..500).map(|_| rng.unit_vector()).collect();
+        let tangents: Vec<Vec4> = rest
+            .iter()
+            .map(|v| v.any_orthonormal_vector().extend(1.0))
+            .collect();
+        let matrices: Vec<Mat4> = random_rotations(joints, 3.0, 5)
+            .into_iter()
+            .map(|q| Mat4::from_rotation_translation(q, rng.unit_vector()))
+            .collect();
+        for k in 1..=6 {
+            let weights = VertexWeights::from_rows((0..rest.len()).map(|_| {
+                (0..k)
+                    .map(|_| {
+                        (
+                            (rng.next_u64() % joints as u64) as u32,
+                            0.05 + rng.next_f64() as f32,
+                        )
+                    })
+                    .collect::<Vec<_>>()
+            }));
+            let skin = CompactSkin::new(&weights, joints, k).unwrap();
+            for method in [SkinningMethod::LinearBlend, SkinningMethod::DualQuaternion] {
+                let mut palette = SkinningPalette::new(joints);
+                palette.update(&matrices, method).unwrap();
+                let n = rest.len();
+                let (mut p, mut nn, mut t) = (
+                    vec![Vec3::ZERO; n],
+                    vec![Vec3::ZERO; n],
+                    vec![Vec4::ZERO; n],
+                );
+                SkinningJob {
+                    skin: &skin,
+                    palette: &palette,
+                    threading: Threading::Sequential,
+                    rest_positions: &rest,
+                    rest_normals: Some(&rest),
+                    rest_tangents: Some(&tangents),
+                    out_positions: &mut p,
+                    out_normals: Some(&mut nn),
+                    out_tangents: Some(&mut t),
+                }
+                .run()
+                .unwrap();
+                let expected = match method {
+                    SkinningMethod::LinearBlend => {
+                        run_portable(palette.matrices(), &skin, &rest, &tangents)
+                    }
+                    SkinningMethod::DualQuaternion => {
+                        run_portable(palette.dual_quaternions(), &skin, &rest, &tangents)
+                    }
+                };
+                for v in 0..n {
+                    assert!(
+                        p[v].abs_diff_eq(expected.0[v], 1e-5),
+                        "k {k} {method:?} position {v}"
+                    );
+                    assert!(
+                        nn[v].abs_diff_eq(expected.1[v], 1e-5),
+                        "k {k} {method:?} normal {v}"
+                    );
+                    assert!(
+                        t[v].abs_diff_eq(expected.2[v], 1e-5),
+                        "k {k} {method:?} tangent {v}"
+                    );
+                }
+            }
+        }
+    }
+}

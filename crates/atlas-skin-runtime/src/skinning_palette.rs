@@ -1,0 +1,183 @@
+//! The per-frame palette in the forms the skinning loops read.
+
+use crate::dual_quaternion::DualQuat;
+use crate::RuntimeError;
+use glam::{Mat3, Mat4};
+
+/// Largest accepted deviation of a palette matrix's linear part from a rotation,
+/// `max |Mᵀ M − I|`, for dual quaternion skinning: covers f32 round-off of composed
+/// hierarchies, rejects any real scale (1.001 already exceeds it).
+pub const RIGID_TOLERANCE: f32 = 1e-3;
+
+/// Which blend deforms the mesh.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SkinningMethod {
+    /// Linear blend skinning: blend the matrices, then transform.
+    #[default]
+    LinearBlend,
+    /// Dual quaternion skinning (Kavan et al. 2007): blend unit dual quaternions with the
+    /// sign fix, normalise, then transform. Needs a rigid palette.
+    DualQuaternion,
+}
+
+/// A skinning palette (`world[j] · inverse_bind[j]` per joint) prepared for a
+/// [`crate::skinning_job::SkinningJob`]: sized once for #J joints, then refilled every
+/// frame by [`SkinningPalette::update`] without allocating.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SkinningPalette {
+    matrices: Vec<Mat4>,
+    dual_quaternions: Vec<DualQuat>,
+    method: SkinningMethod,
+}
+
+impl SkinningPalette {
+    /// A palette of `joint_count` identity transforms, ready for either method.
+    pub fn new(joint_count: usize) -> Self {
+        Self {
+            matrices: vec![Mat4::IDENTITY; joint_count],
+            dual_quaternions: vec![DualQuat::from_rigid(&Mat4::IDENTITY); joint_count],
+            method: SkinningMethod::DualQuaternion,
+        }
+    }
+
+    /// Copies `palette` (#J matrices, the length given to [`SkinningPalette::new`]) and,
+    /// for [`SkinningMethod::DualQuaternion`], converts each to a unit dual quaternion.
+    ///
+    /// Errors: [`RuntimeError::BufferSize`] for a wrong length,
+    /// [`RuntimeError::NonFinitePalette`], and for dual quaternions
+    /// [`RuntimeError::NonRigid`] when a matrix's linear part is not a rotation within
+    /// [`RIGID_TOLERANCE`] (scale is rejected, not approximated: a unit dual quaternion
+    /// cannot carry it). The projective row must be (0, 0, 0, 1) for both methods.
+    pub fn update(&mut self, palette: &[Mat4], method: SkinningMethod) -> Result<(), RuntimeError> {
+        if palette.len() != self.matrices.len() {
+            return Err(RuntimeError::BufferSize {
+                what: format!(
+                    "palette has {} matrices, the skinning palette was made for {}",
+                    palette.len(),
+                    self.matrices.len()
+                ),
+            });
+        }
+        for (joint, m) in palette.iter().enumerate() {
+            if !m.is_finite() {
+                return Err(RuntimeError::NonFinitePalette { joint });
+            }
+            if m.row(3) != glam::Vec4::W {
+                return Err(RuntimeError::NonRigid {
+                    joint,
+                    scale: m.row(3).w,
+                });
+            }
+        }
+        self.matrices.copy_from_slice(palette);
+        self.method = method;
+        if method == SkinningMethod::DualQuaternion {
+            for (joint, (m, dq)) in palette.iter().zip(&mut self.dual_quaternions).enumerate() {
+                check_rigid(joint, m)?;
+                *dq = DualQuat::from_rigid(m);
+            }
+        }
+        Ok(())
+    }
+
+    /// Number of joints.
+    pub fn len(&self) -> usize {
+        self.matrices.len()
+    }
+
+    /// True for a palette of no joint.
+    pub fn is_empty(&self) -> bool {
+        self.matrices.is_empty()
+    }
+
+    /// The method of the last [`SkinningPalette::update`].
+    pub fn method(&self) -> SkinningMethod {
+        self.method
+    }
+
+    /// #J matrices.
+    pub fn matrices(&self) -> &[Mat4] {
+        &self.matrices
+    }
+
+    /// #J unit dual quaternions (valid after an update for dual quaternion skinning).
+    pub fn dual_quaternions(&self) -> &[DualQuat] {
+        &self.dual_quaternions
+    }
+}
+
+/// Rejects a matrix whose linear part `L` has `max |Lᵀ L − I| > RIGID_TOLERANCE` or a
+/// negative determinant (a reflection); the reported scale is the column length furthest
+/// from 1.
+fn check_rigid(joint: usize, m: &Mat4) -> Result<(), RuntimeError> {
+    let linear = Mat3::from_mat4(*m);
+    let gram = linear.transpose() * linear - Mat3::IDENTITY;
+    let deviation = gram
+        .to_cols_array()
+        .iter()
+        .fold(0.0f32, |a, &e| a.max(e.abs()));
+    if deviation > RIGID_TOLERANCE || linear.determinant() < 0.0 {
+        let lengths = [
+            linear.x_axis.length(),
+            linear.y_axis.length(),
+            linear.z_axis.length(),
+        ];
+        let scale = lengths
+            .into_iter()
+            .max_by(|a, b| (a - 1.0).abs().total_cmp(&(b - 1.0).abs()))
+            .unwrap_or(1.0);
+        let scale = if linear.determinant() < 0.0 {
+            -scale
+        } else {
+            scale
+        };
+        return Err(RuntimeError::NonRigid { joint, scale });
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::{Quat, Vec3};
+
+    #[test]
+    fn invalid_palettes_are_rejected() {
+        let rigid = Mat4::from_rotation_translation(Quat::from_rotation_x(1.0), Vec3::ONE);
+        let mut projective = rigid;
+        projective.x_axis.w = 0.5;
+        let cases = [
+            (vec![rigid], SkinningMethod::LinearBlend),
+            (
+                vec![rigid, Mat4::from_translation(Vec3::NAN)],
+                SkinningMethod::LinearBlend,
+            ),
+            (vec![rigid, projective], SkinningMethod::LinearBlend),
+            (
+                vec![rigid, Mat4::from_scale(Vec3::splat(1.01))],
+                SkinningMethod::DualQuaternion,
+            ),
+            (
+                vec![rigid, Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0))],
+                SkinningMethod::DualQuaternion,
+            ),
+        ];
+        for (matrices, method) in cases {
+            let mut palette = SkinningPalette::new(2);
+            assert!(
+                palette.update(&matrices, method).is_err(),
+                "accepted {matrices:?}"
+            );
+        }
+        let mut palette = SkinningPalette::new(2);
+        let scaled = [rigid, Mat4::from_scale(Vec3::splat(2.0))];
+        assert!(palette.update(&scaled, SkinningMethod::LinearBlend).is_ok());
+        assert_eq!(
+            palette.update(&scaled, SkinningMethod::DualQuaternion),
+            Err(RuntimeError::NonRigid {
+                joint: 1,
+                scale: 2.0
+            })
+        );
+    }
+}

@@ -1,0 +1,309 @@
+//! The fast skinning job against the scalar reference, and the properties the issue
+//! names: identity pose = rest mesh, one rigid joint = that transform, the candy wrapper.
+
+use atlas_skin_runtime::reference::{
+    dual_quaternion_positions, dual_quaternion_vectors, linear_blend_positions,
+    linear_blend_vectors,
+};
+use atlas_skin_runtime::{
+    CompactSkin, RuntimeError, SkinningJob, SkinningMethod, SkinningPalette, Threading,
+    VertexWeights,
+};
+use glam::{Mat4, Quat, Vec3, Vec4};
+use proptest::prelude::*;
+
+/// Output streams of one run.
+struct Posed {
+    positions: Vec<Vec3>,
+    normals: Vec<Vec3>,
+    tangents: Vec<Vec4>,
+}
+
+fn run_job(
+    skin: &CompactSkin,
+    matrices: &[Mat4],
+    method: SkinningMethod,
+    threading: Threading,
+    rest_positions: &[Vec3],
+    rest_normals: &[Vec3],
+) -> Result<Posed, RuntimeError> {
+    let mut palette = SkinningPalette::new(matrices.len());
+    palette.update(matrices, method)?;
+    let rest_tangents: Vec<Vec4> = rest_normals
+        .iter()
+        .map(|n| n.any_orthonormal_vector().extend(-1.0))
+        .collect();
+    let n = rest_positions.len();
+    let mut posed = Posed {
+        positions: vec![Vec3::ZERO; n],
+        normals: vec![Vec3::ZERO; n],
+        tangents: vec![Vec4::ZERO; n],
+    };
+    SkinningJob {
+        skin,
+        palette: &palette,
+        threading,
+        rest_positions,
+        rest_normals: Some(rest_normals),
+        rest_tangents: Some(&rest_tangents),
+        out_positions: &mut posed.positions,
+        out_normals: Some(&mut posed.normals),
+        out_tangents: Some(&mut posed.tangents),
+    }
+    .run()?;
+    Ok(posed)
+}
+
+fn diagonal(points: &[Vec3]) -> f32 {
+    let (lo, hi) = points.iter().fold((Vec3::MAX, Vec3::MIN), |(lo, hi), p| {
+        (lo.min(*p), hi.max(*p))
+    });
+    (hi - lo).length()
+}
+
+fn max_distance(a: &[Vec3], b: &[Vec3]) -> f32 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| x.distance(*y))
+        .fold(0.0, f32::max)
+}
+
+/// A random rigid transform: rotation from four floats, translation from three.
+fn rigid(r: [f32; 4], t: [f32; 3]) -> Mat4 {
+    let q = Vec4::from(r);
+    let q = if q.length() < 1e-3 {
+        Quat::IDENTITY
+    } else {
+        Quat::from_vec4(q).normalize()
+    };
+    Mat4::from_rotation_translation(q, Vec3::from(t))
+}
+
+fn weights_strategy(vertices: usize, joints: u32) -> impl Strategy<Value = VertexWeights> {
+    prop::collection::vec(
+        prop::collection::vec((0..joints, 0.01f32..1.0), 1..7),
+        vertices,
+    )
+    .prop_map(VertexWeights::from_rows)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// Every specialisation (K = 1…4 and N, sequential and parallel) matches the scalar
+    /// reference within 1e-5 of the bounding-box diagonal.
+    #[test]
+    fn fast_paths_match_the_reference(
+        rows in weights_strategy(300, 6),
+        rotations in prop::collection::vec(prop::array::uniform4(-1.0f32..1.0), 6),
+        translations in prop::collection::vec(prop::array::uniform3(-2.0f32..2.0), 6),
+        points in prop::collection::vec(prop::array::uniform3(-1.0f32..1.0), 300),
+        max_influences in 1usize..7,
+        parallel in any::<bool>(),
+    ) {
+        let matrices: Vec<Mat4> = rotations.iter().zip(&translations).map(|(r, t)| rigid(*r, *t)).collect();
+        let rest: Vec<Vec3> = points.iter().map(|p| Vec3::from(*p)).collect();
+        let normals: Vec<Vec3> = rest.iter().map(|p| p.normalize_or(Vec3::Z)).collect();
+        let skin = CompactSkin::new(&rows, 6, max_influences).unwrap();
+        let reference_weights = skin.to_vertex_weights();
+        let threading = if parallel { Threading::Parallel } else { Threading::Sequential };
+        let mut expected_p = vec![Vec3::ZERO; rest.len()];
+        let mut expected_n = vec![Vec3::ZERO; rest.len()];
+        let tolerance = 1e-5 * diagonal(&rest);
+        for method in [SkinningMethod::LinearBlend, SkinningMethod::DualQuaternion] {
+            let posed = run_job(&skin, &matrices, method, threading, &rest, &normals).unwrap();
+            match method {
+                SkinningMethod::LinearBlend => {
+                    linear_blend_positions(&rest, &reference_weights, &matrices, &mut expected_p);
+                    linear_blend_vectors(&normals, &reference_weights, &matrices, &mut expected_n);
+                }
+                SkinningMethod::DualQuaternion => {
+                    dual_quaternion_positions(&rest, &reference_weights, &matrices, &mut expected_p);
+                    dual_quaternion_vectors(&normals, &reference_weights, &matrices, &mut expected_n);
+                }
+            }
+            prop_assert!(max_distance(&posed.positions, &expected_p) <= tolerance, "{method:?} positions");
+            prop_assert!(max_distance(&posed.normals, &expected_n) <= 1e-5, "{method:?} normals");
+        }
+    }
+
+    /// An identity palette reproduces the rest streams bit for bit.
+    #[test]
+    fn identity_pose_reproduces_the_rest_mesh_exactly(
+        rows in weights_strategy(200, 5),
+        points in prop::collection::vec(prop::array::uniform3(-100.0f32..100.0), 200),
+        max_influences in 1usize..7,
+    ) {
+        let rest: Vec<Vec3> = points.iter().map(|p| Vec3::from(*p)).collect();
+        let normals: Vec<Vec3> = rest.iter().map(|p| p.normalize_or(Vec3::Z)).collect();
+        let skin = CompactSkin::new(&rows, 5, max_influences).unwrap();
+        for method in [SkinningMethod::LinearBlend, SkinningMethod::DualQuaternion] {
+            let posed = run_job(&skin, &[Mat4::IDENTITY; 5], method, Threading::Sequential, &rest, &normals).unwrap();
+            prop_assert_eq!(&posed.positions, &rest);
+            prop_assert_eq!(&posed.normals, &normals);
+        }
+    }
+}
+
+#[test]
+fn one_rigid_joint_moves_the_mesh_rigidly() {
+    let rest: Vec<Vec3> = (0..50)
+        .map(|i| Vec3::new(i as f32 * 0.1, (i % 7) as f32, -(i % 3) as f32))
+        .collect();
+    let normals = vec![Vec3::Y; rest.len()];
+    let weights = VertexWeights::from_rows(rest.iter().map(|_| vec![(1, 1.0)]));
+    let skin = CompactSkin::new(&weights, 2, 4).unwrap();
+    let moved = rigid([0.3, -0.2, 0.9, 0.5], [1.0, 2.0, -3.0]);
+    for method in [SkinningMethod::LinearBlend, SkinningMethod::DualQuaternion] {
+        let posed = run_job(
+            &skin,
+            &[Mat4::IDENTITY, moved],
+            method,
+            Threading::Parallel,
+            &rest,
+            &normals,
+        )
+        .unwrap();
+        for (p, q) in rest.iter().zip(&posed.positions) {
+            assert!(
+                q.abs_diff_eq(moved.transform_point3(*p), 1e-5),
+                "{method:?}"
+            );
+        }
+        assert!(posed.normals[0].abs_diff_eq(moved.transform_vector3(Vec3::Y), 1e-6));
+        assert_eq!(posed.tangents[0].w, -1.0);
+    }
+}
+
+/// Kavan et al. 2007 §1: a cylinder along x bound to two joints, the far one twisted by
+/// 150° about the axis. A ring at the middle (equal weights) keeps its edge lengths under
+/// DQS, which blends to the 75° twist, and collapses towards the axis under LBS.
+#[test]
+fn candy_wrapper_dqs_keeps_edge_lengths_lbs_shrinks_them() {
+    let ring = 24;
+    let rest: Vec<Vec3> = (0..ring)
+        .map(|i| {
+            let a = std::f32::consts::TAU * i as f32 / ring as f32;
+            Vec3::new(1.0, a.cos(), a.sin())
+        })
+        .collect();
+    let normals: Vec<Vec3> = rest.iter().map(|p| Vec3::new(0.0, p.y, p.z)).collect();
+    let weights = VertexWeights::from_rows(rest.iter().map(|_| vec![(0, 0.5), (1, 0.5)]));
+    let skin = CompactSkin::new(&weights, 2, 4).unwrap();
+    let twist = Mat4::from_rotation_x(150f32.to_radians());
+    let edge = |p: &[Vec3], i: usize| p[i].distance(p[(i + 1) % ring]);
+    let lbs = run_job(
+        &skin,
+        &[Mat4::IDENTITY, twist],
+        SkinningMethod::LinearBlend,
+        Threading::Sequential,
+        &rest,
+        &normals,
+    )
+    .unwrap();
+    let dqs = run_job(
+        &skin,
+        &[Mat4::IDENTITY, twist],
+        SkinningMethod::DualQuaternion,
+        Threading::Sequential,
+        &rest,
+        &normals,
+    )
+    .unwrap();
+    for i in 0..ring {
+        assert!((edge(&dqs.positions, i) - edge(&rest, i)).abs() < 1e-5);
+        // cos 75° ≈ 0.26: LBS shrinks the ring to about a quarter.
+        assert!(edge(&lbs.positions, i) < 0.3 * edge(&rest, i));
+    }
+}
+
+/// A table of invalid jobs, each rejected before any vertex is touched (as ozz's tests):
+/// every case breaks one rule of a valid job.
+#[test]
+fn invalid_jobs_are_rejected() {
+    let weights = VertexWeights::from_rows([vec![(0, 1.0)], vec![(1, 1.0)]]);
+    let skin = CompactSkin::new(&weights, 2, 4).unwrap();
+    let palette = SkinningPalette::new(2);
+    let short_palette = SkinningPalette::new(1);
+    let rest = [Vec3::ZERO; 2];
+    let short = [Vec3::ZERO; 1];
+    let tangents = [Vec4::ZERO; 2];
+    for case in 0..7 {
+        let mut out = [Vec3::ZERO; 2];
+        let mut out_short = [Vec3::ZERO; 1];
+        let mut out_normals = [Vec3::ZERO; 2];
+        let mut out_tangents = [Vec4::ZERO; 2];
+        let mut job = SkinningJob {
+            skin: &skin,
+            palette: &palette,
+            threading: Threading::Sequential,
+            rest_positions: &rest,
+            rest_normals: None,
+            rest_tangents: None,
+            out_positions: &mut out,
+            out_normals: None,
+            out_tangents: None,
+        };
+        match case {
+            0 => {
+                assert!(job.run().is_ok());
+                continue;
+            }
+            1 => job.palette = &short_palette,
+            2 => job.rest_positions = &short,
+            3 => job.out_positions = &mut out_short,
+            4 => job.rest_normals = Some(&rest),
+            5 => {
+                job.rest_normals = Some(&short);
+                job.out_normals = Some(&mut out_normals);
+            }
+            _ => {
+                job.rest_tangents = Some(&tangents[..1]);
+                job.out_tangents = Some(&mut out_tangents);
+            }
+        }
+        assert!(job.validate().is_err(), "case {case} accepted");
+        assert!(job.run().is_err(), "case {case} ran");
+    }
+}
+
+/// Enough vertices for several parallel chunks: the split must not change any result.
+#[test]
+fn parallel_run_equals_sequential_run_bit_for_bit() {
+    let count = 3 * atlas_skin_runtime::skinning_job::PARALLEL_CHUNK + 17;
+    let rest: Vec<Vec3> = (0..count)
+        .map(|i| Vec3::new(i as f32, (i % 13) as f32, 1.0))
+        .collect();
+    let normals = vec![Vec3::Z; count];
+    let weights =
+        VertexWeights::from_rows((0..count as u32).map(|i| vec![(i % 3, 1.0), ((i + 1) % 3, 0.5)]));
+    let skin = CompactSkin::new(&weights, 3, 4).unwrap();
+    let matrices = [
+        rigid([0.1, 0.2, 0.3, 0.9], [1.0, 0.0, 0.0]),
+        Mat4::IDENTITY,
+        rigid([0.5, 0.0, 0.0, 0.5], [0.0, 2.0, 0.0]),
+    ];
+    for method in [SkinningMethod::LinearBlend, SkinningMethod::DualQuaternion] {
+        let sequential = run_job(
+            &skin,
+            &matrices,
+            method,
+            Threading::Sequential,
+            &rest,
+            &normals,
+        )
+        .unwrap();
+        let parallel = run_job(
+            &skin,
+            &matrices,
+            method,
+            Threading::Parallel,
+            &rest,
+            &normals,
+        )
+        .unwrap();
+        assert_eq!(sequential.positions, parallel.positions);
+        assert_eq!(sequential.normals, parallel.normals);
+        assert_eq!(sequential.tangents, parallel.tangents);
+    }
+}

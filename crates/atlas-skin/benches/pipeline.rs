@@ -1,0 +1,134 @@
+//! Speed of the whole method after parsing and welding: decomposition, distances, weights
+//! and weights per stored vertex ([`atlas_skin::pipeline::skin`]).
+//!
+//! `cargo bench -p atlas-skin --bench pipeline`. Targets (release, 2 cores): cesiumman
+//! ≤ 5 ms, makehuman's body ≤ 60 ms, a character of over a million triangles (makehuman's
+//! body subdivided three times: 1.7M triangles) under 15 s and 4 GB; the peak resident
+//! memory of the process is printed at the end.
+
+use atlas_skin::pipeline::{skin, SkinParams};
+use atlas_skin::weld::DEFAULT_WELD_TOLERANCE;
+use atlas_skin::{weld, Topology, Welded};
+use atlas_skin_io::{load_character, Character, LoadOptions, TriangleMesh};
+use atlas_skin_runtime::Skeleton;
+use divan::Bencher;
+use glam::Vec3;
+use std::collections::HashMap;
+use std::path::Path;
+
+const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/models");
+
+fn main() {
+    divan::main();
+    if let Ok(status) = std::fs::read_to_string("/proc/self/status") {
+        if let Some(line) = status.lines().find(|l| l.starts_with("VmHWM")) {
+            println!(
+                "peak resident memory: {}",
+                line.trim_start_matches("VmHWM:").trim()
+            );
+        }
+    }
+}
+
+fn load(folder: &str, input: &str, skeleton: Option<&str>, group: Option<&str>) -> Character {
+    let folder = Path::new(DATA).join(folder);
+    let options = LoadOptions {
+        skeleton: skeleton.map(|s| folder.join(s)),
+        group: group.map(String::from),
+        weights: None,
+    };
+    load_character(&folder.join(input), &options)
+        .unwrap_or_else(|e| panic!("the corpus is needed for this benchmark: {e}"))
+}
+
+fn makehuman() -> Character {
+    load(
+        "makehuman",
+        "base.obj",
+        Some("default.mhskel"),
+        Some("body"),
+    )
+}
+
+/// Splits every triangle into four at its edge midpoints, `levels` times (the surface and
+/// its shape are unchanged; vertices and triangles grow fourfold per level).
+fn subdivide(mesh: &TriangleMesh, levels: usize) -> TriangleMesh {
+    let mut out = mesh.clone();
+    for _ in 0..levels {
+        let mut midpoints: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut positions = out.positions.clone();
+        let mut midpoint = |a: u32, b: u32| {
+            *midpoints.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                positions.push((positions[a as usize] + positions[b as usize]) * 0.5);
+                positions.len() as u32 - 1
+            })
+        };
+        let triangles = out
+            .triangles
+            .iter()
+            .flat_map(|&[a, b, c]| {
+                let (ab, bc, ca) = (midpoint(a, b), midpoint(b, c), midpoint(c, a));
+                [[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]
+            })
+            .collect();
+        out = TriangleMesh {
+            positions,
+            triangles,
+        };
+    }
+    out
+}
+
+struct Prepared {
+    positions: Vec<Vec3>,
+    welded: Welded,
+    topology: Topology,
+    skeleton: Skeleton,
+}
+
+fn prepare(mesh: &TriangleMesh, skeleton: Option<Skeleton>) -> Prepared {
+    let welded = weld(&mesh.positions, &mesh.triangles, DEFAULT_WELD_TOLERANCE);
+    let topology = Topology::new(&welded.mesh);
+    Prepared {
+        positions: mesh.positions.clone(),
+        welded,
+        topology,
+        skeleton: skeleton.expect("the model has a skeleton"),
+    }
+}
+
+fn bench_skin(bencher: Bencher, prepared: &Prepared) {
+    let params = SkinParams::default();
+    bencher
+        .counter(prepared.welded.mesh.triangle_count())
+        .bench(|| {
+            skin(
+                &prepared.welded,
+                &prepared.topology,
+                &prepared.positions,
+                &prepared.skeleton,
+                &params,
+                &mut |_| {},
+            )
+            .expect("skins")
+        });
+}
+
+#[divan::bench(sample_count = 20)]
+fn cesiumman(bencher: Bencher) {
+    let character = load("cesiumman", "CesiumMan.glb", None, None);
+    bench_skin(bencher, &prepare(&character.mesh, character.skeleton));
+}
+
+#[divan::bench(sample_count = 20)]
+fn makehuman_body(bencher: Bencher) {
+    let character = makehuman();
+    bench_skin(bencher, &prepare(&character.mesh, character.skeleton));
+}
+
+#[divan::bench(sample_count = 2, sample_size = 1)]
+fn makehuman_body_subdivided_1m(bencher: Bencher) {
+    let character = makehuman();
+    let mesh = subdivide(&character.mesh, 3);
+    bench_skin(bencher, &prepare(&mesh, character.skeleton));
+}

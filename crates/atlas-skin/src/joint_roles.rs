@@ -1,0 +1,353 @@
+//! Which joints get a boundary (Lu et al. 2008 §3.1, and METHOD.md "Measured on real rigs").
+//!
+//! The rules, in the order they are applied to joint J at bind position p_J:
+//! 1. Forbidden by the user: no boundary. Forced by the user: a boundary, whatever follows.
+//! 2. A root has no upper bone to cut: its region is the root region.
+//! 3. A branching joint (two or more children) on the skeleton's mirror plane (pelvis,
+//!    chest) has no boundary, as in the paper. Off the plane (a clavicle with a breast bone,
+//!    a wrist with five finger bones) it is cut like a chain joint whose lower bone is the
+//!    mean of its unit child directions — for a wrist, the average finger direction.
+//! 4. A leaf owns geometry when its parent's bone runs on into the mesh: the ray from p_J
+//!    along the upper bone leaves the surface from inside (hit face normal along the ray on
+//!    an outward-oriented surface) at a distance ≥ `leaf_extent_ratio` × the joint's
+//!    surface distance. It is then cut with lower bone = upper bone. Otherwise it is an end
+//!    site: no boundary.
+//! 5. A joint lies outside the mesh and owns no geometry when it is farther from the
+//!    surface than `outside_ratio` × its longest bone and outside it: most of six rays from
+//!    it (±x, ±y, ±z, slightly turned) first meet the surface from outside, or not at all.
+//!    Then: no boundary. A joint near the surface (a face bone in an eye socket) keeps its
+//!    boundary: the skin around it is its to move. A winding number is not used: it fails
+//!    on open and multi-piece meshes; the ray vote needs only a locally outward surface.
+//! 6. Twist and helper joints on a straight bone are chain joints with collinear bones: they
+//!    are cut perpendicular to the bone (the cone search), and the weights stage blends the
+//!    regions of one limb; nothing tells them apart from a straight elbow geometrically.
+//!
+//! The mirror plane is inferred from joint positions alone (names are not used): the plane
+//! x · n = c, among the coordinate planes and the bisector planes of sibling pairs of equal
+//! bone length, that maps the joint set best onto itself.
+
+use crate::decompose::DecomposeParams;
+use crate::proximity::FaceSpheres;
+use crate::SurfaceMesh;
+use atlas_skin_runtime::Skeleton;
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// The skeleton's mirror plane: points x with n · x = `offset`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SymmetryPlane {
+    pub normal: DVec3,
+    pub offset: f64,
+    /// Mean distance from a reflected joint to the nearest joint, relative to the
+    /// skeleton's bounding-box diagonal.
+    pub mismatch: f64,
+}
+
+/// The bones around a joint that gets a boundary.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointFrame {
+    /// p_J.
+    pub position: DVec3,
+    /// Unit direction of the upper bone (parent → J).
+    pub upper: DVec3,
+    /// Unit direction of the lower bone (J → child, see the rules).
+    pub lower: DVec3,
+    /// Length of the shortest non-zero adjacent bone.
+    pub bone_length: f64,
+    /// Distance from p_J to the nearest surface point.
+    pub surface_distance: f64,
+}
+
+/// What the decomposition does at one joint.
+#[derive(Debug, Clone, PartialEq)]
+pub enum JointPlan {
+    /// Search a cut (and fall back to a soft boundary).
+    Boundary(JointFrame),
+    /// No boundary, with the reason for the report.
+    Skip(String),
+}
+
+/// A user override for one joint.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Override {
+    Force,
+    Forbid,
+}
+
+/// Bones shorter than this fraction of the skeleton's diagonal have no direction.
+const ZERO_BONE: f64 = 1e-9;
+
+/// Decides, for every joint of `skeleton` (bind positions `positions`), whether it gets a
+/// boundary; `overrides` has one entry per joint.
+pub fn plan_joints(
+    mesh: &SurfaceMesh,
+    spheres: &FaceSpheres,
+    skeleton: &Skeleton,
+    positions: &[DVec3],
+    overrides: &[Option<Override>],
+    params: &DecomposeParams,
+) -> (Option<SymmetryPlane>, Vec<JointPlan>) {
+    let children = skeleton.children();
+    let scale = diagonal(positions).max(f64::MIN_POSITIVE);
+    let symmetry = infer_symmetry_plane(skeleton, positions, params.symmetry_tolerance);
+    let orientation = orientation_sign(mesh);
+    let plans = (0..skeleton.len())
+        .into_par_iter()
+        .map(|j| {
+            let forced = overrides[j] == Some(Override::Force);
+            if overrides[j] == Some(Override::Forbid) {
+                return JointPlan::Skip("forbidden by the user".into());
+            }
+            let p = positions[j];
+            let parent = skeleton.parent(j);
+            if parent.is_none() && !forced {
+                return JointPlan::Skip("root joint: no upper bone to cut".into());
+            }
+            let upper_vector = parent.map_or(DVec3::ZERO, |q| p - positions[q]);
+            let child_vectors: Vec<DVec3> = children[j]
+                .iter()
+                .map(|&c| positions[c] - p)
+                .filter(|v| v.length() > ZERO_BONE * scale)
+                .collect();
+            let lower_mean: DVec3 = child_vectors.iter().map(|v| v.normalize()).sum();
+            let upper = if upper_vector.length() > ZERO_BONE * scale {
+                upper_vector.normalize()
+            } else {
+                lower_mean.normalize_or_zero()
+            };
+            let lower = lower_mean.try_normalize().unwrap_or(upper);
+            if upper == DVec3::ZERO {
+                return JointPlan::Skip("zero-length bones: no direction to cut across".into());
+            }
+            let bone_length = std::iter::once(upper_vector.length())
+                .chain(child_vectors.iter().map(|v| v.length()))
+                .filter(|&l| l > ZERO_BONE * scale)
+                .fold(f64::INFINITY, f64::min);
+            let longest_bone = std::iter::once(upper_vector.length())
+                .chain(child_vectors.iter().map(|v| v.length()))
+                .fold(0.0, f64::max);
+            let surface_distance = spheres.nearest_distance(mesh, p);
+            let frame = JointFrame {
+                position: p,
+                upper,
+                lower,
+                bone_length,
+                surface_distance,
+            };
+            if forced {
+                return JointPlan::Boundary(frame);
+            }
+            if children[j].len() >= 2 {
+                if let Some(plane) = &symmetry {
+                    let off = (plane.normal.dot(p) - plane.offset).abs();
+                    if off <= params.symmetry_tolerance * scale {
+                        return JointPlan::Skip(format!(
+                            "branching joint on the mirror plane ({} children)",
+                            children[j].len()
+                        ));
+                    }
+                }
+            }
+            if surface_distance > params.outside_ratio * longest_bone
+                && !is_inside_by_rays(mesh, spheres, p, orientation)
+            {
+                return JointPlan::Skip(format!(
+                    "outside the mesh, owns no geometry: nearest surface {surface_distance:.4} \
+                     away, longest bone {longest_bone:.4}"
+                ));
+            }
+            if children[j].is_empty() {
+                let extent = spheres
+                    .first_hit(mesh, p, upper)
+                    .filter(|hit| {
+                        let n = mesh.scaled_normal(hit.face as usize);
+                        orientation * n.dot(upper) >= 0.0
+                    })
+                    .map(|hit| hit.distance);
+                match extent {
+                    Some(t) if t >= params.leaf_extent_ratio * surface_distance => {}
+                    _ => {
+                        return JointPlan::Skip(
+                            "end site: the bone does not run on into the mesh".into(),
+                        )
+                    }
+                }
+            }
+            JointPlan::Boundary(frame)
+        })
+        .collect();
+    (symmetry, plans)
+}
+
+/// Whether at least four of six rays from `p` first meet the surface leaving it (the hit
+/// face's normal, times `orientation`, along the ray). The directions are the axes turned
+/// by a small irrational rotation so that they do not run along axis-aligned edges.
+fn is_inside_by_rays(
+    mesh: &SurfaceMesh,
+    spheres: &FaceSpheres,
+    p: DVec3,
+    orientation: f64,
+) -> bool {
+    let turn = glam::DQuat::from_euler(glam::EulerRot::XYZ, 0.1234, 0.2345, 0.3456);
+    let exits = [
+        DVec3::X,
+        -DVec3::X,
+        DVec3::Y,
+        -DVec3::Y,
+        DVec3::Z,
+        -DVec3::Z,
+    ]
+    .into_iter()
+    .filter(|&axis| {
+        let direction = turn * axis;
+        spheres.first_hit(mesh, p, direction).is_some_and(|hit| {
+            orientation * mesh.scaled_normal(hit.face as usize).dot(direction) > 0.0
+        })
+    })
+    .count();
+    exits >= 4
+}
+
+/// +1 for an outward-oriented closed surface, −1 for an inward one, 0 when the signed
+/// volume Σ a · (b × c) / 6 is negligible (open strips): ray hits are then not filtered.
+fn orientation_sign(mesh: &SurfaceMesh) -> f64 {
+    let volume: f64 = mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
+            a.dot(b.cross(c)) / 6.0
+        })
+        .sum();
+    if volume.abs() <= 1e-9 * mesh.diagonal().powi(3) {
+        0.0
+    } else {
+        volume.signum()
+    }
+}
+
+fn diagonal(points: &[DVec3]) -> f64 {
+    let (lo, hi) = crate::mesh::bounding_box(points);
+    (hi - lo).length()
+}
+
+/// The mirror plane of the joint set, if one maps it onto itself within `tolerance` × the
+/// skeleton's diagonal (mean nearest-joint distance of the reflected joints) and reflects at
+/// least one pair of joints onto each other.
+///
+/// Candidates: normals ±x, ±y, ±z and p_i − p_j for sibling joints i, j whose bones have
+/// equal length (within 5%); offset c = median of n · p over the joints. O(J² · candidates).
+pub fn infer_symmetry_plane(
+    skeleton: &Skeleton,
+    positions: &[DVec3],
+    tolerance: f64,
+) -> Option<SymmetryPlane> {
+    let scale = diagonal(positions);
+    if positions.len() < 3 || scale <= 0.0 {
+        return None;
+    }
+    let mut normals = vec![DVec3::X, DVec3::Y, DVec3::Z];
+    for siblings in skeleton.children() {
+        for (k, &a) in siblings.iter().enumerate() {
+            for &b in &siblings[k + 1..] {
+                let Some(p) = skeleton.parent(a) else {
+                    continue;
+                };
+                let (la, lb) = (
+                    positions[a].distance(positions[p]),
+                    positions[b].distance(positions[p]),
+                );
+                if (la - lb).abs() <= 0.05 * la.max(lb) {
+                    if let Some(n) = (positions[a] - positions[b]).try_normalize() {
+                        normals.push(n);
+                    }
+                }
+            }
+        }
+        if normals.len() > 24 {
+            break;
+        }
+    }
+    normals
+        .into_iter()
+        .filter_map(|normal| {
+            let mut heights: Vec<f64> = positions.iter().map(|p| normal.dot(*p)).collect();
+            heights.sort_unstable_by(f64::total_cmp);
+            let offset = heights[heights.len() / 2];
+            let mut paired = 0;
+            let mut total = 0.0;
+            for p in positions {
+                let height = normal.dot(*p) - offset;
+                let mirrored = *p - 2.0 * height * normal;
+                total += positions
+                    .iter()
+                    .map(|q| q.distance(mirrored))
+                    .fold(f64::INFINITY, f64::min);
+                if height.abs() > tolerance * scale {
+                    paired += 1;
+                }
+            }
+            let mismatch = total / positions.len() as f64 / scale;
+            (paired >= 2 && mismatch <= tolerance).then_some(SymmetryPlane {
+                normal,
+                offset,
+                mismatch,
+            })
+        })
+        .min_by(|a, b| a.mismatch.total_cmp(&b.mismatch))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use atlas_skin_runtime::NO_PARENT;
+
+    /// A stick figure: pelvis (root) with spine and two legs, chest with neck and two arms.
+    fn stick_figure(tilt: f64) -> (Skeleton, Vec<DVec3>) {
+        let raw = [
+            ("pelvis", NO_PARENT, [0.0, 1.0, 0.0]),
+            ("chest", 0, [0.0, 1.5, 0.0]),
+            ("neck", 1, [0.0, 1.7, 0.0]),
+            ("arm.L", 1, [0.3, 1.5, 0.0]),
+            ("hand.L", 3, [0.8, 1.4, 0.0]),
+            ("arm.R", 1, [-0.3, 1.5, 0.0]),
+            ("hand.R", 5, [-0.8, 1.4, 0.0]),
+            ("leg.L", 0, [0.1, 0.9, 0.0]),
+            ("foot.L", 7, [0.1, 0.0, 0.1]),
+            ("leg.R", 0, [-0.1, 0.9, 0.0]),
+            ("foot.R", 9, [-0.1, 0.0, 0.1]),
+        ];
+        let rotation = glam::DQuat::from_rotation_y(tilt);
+        let positions: Vec<DVec3> = raw
+            .iter()
+            .map(|r| rotation * DVec3::from_array(r.2))
+            .collect();
+        let skeleton = Skeleton::from_positions(
+            raw.iter().map(|r| r.0.to_string()).collect(),
+            raw.iter().map(|r| r.1).collect(),
+            &positions.iter().map(|p| p.as_vec3()).collect::<Vec<_>>(),
+        )
+        .expect("valid skeleton");
+        (skeleton, positions)
+    }
+
+    #[test]
+    fn mirror_plane_of_a_stick_figure_is_found_even_when_rotated() {
+        for tilt in [0.0, 0.4] {
+            let (skeleton, positions) = stick_figure(tilt);
+            let plane = infer_symmetry_plane(&skeleton, &positions, 0.02).expect("symmetric");
+            let expected = glam::DQuat::from_rotation_y(tilt) * DVec3::X;
+            assert!(plane.normal.dot(expected).abs() > 0.999, "{plane:?}");
+            assert!(plane.offset.abs() < 1e-6 && plane.mismatch < 1e-6);
+        }
+    }
+
+    #[test]
+    fn a_lopsided_skeleton_has_no_mirror_plane() {
+        let (mut skeleton, mut positions) = stick_figure(0.0);
+        positions[4] = DVec3::new(0.6, 2.0, 0.5);
+        positions[8] = DVec3::new(0.5, 0.3, -0.6);
+        skeleton.inverse_bind[4] = glam::Mat4::from_translation(-positions[4].as_vec3());
+        assert!(infer_symmetry_plane(&skeleton, &positions, 0.02).is_none());
+    }
+}

@@ -1,0 +1,722 @@
+//! Skinning weights from a decomposition (Lu et al. 2008, §4 and §5), with the extensions
+//! METHOD.md measured: soft boundaries with weights that change along the chain inside a
+//! region, and weights for every vertex.
+//!
+//! For a vertex p of the split surface:
+//!
+//! 1. **Related regions and depths.** A region V_i is related to p when p lies in V_i (a
+//!    face of p belongs to it) or within the overlap band of one of V_i's cut curves. Its
+//!    normalised depth ([`crate::blend`]) is, with g_k the surface distance from p to the
+//!    curve of boundary k and w_k its overlap half-width ([`crate::overlap`]):
+//!    λ_i = min_k (w_k + g_k) / (2 w_k) when p lies in V_i (∞ when no band reaches p),
+//!    λ_i = max_k (w_k − g_k) / (2 w_k) when it does not (k over V_i's cuts reaching p).
+//!    Both give ½ on a curve, so λ_i is continuous across it; regions with λ_i ≤ 0 are not
+//!    related.
+//! 2. **Blend** the related regions: ω_i from the λ_i by [`blend_regions`].
+//! 3. **Chain weights inside a region.** A region holding several joints has a soft
+//!    boundary for each joint after the first (the bound one). Joint c's soft boundary
+//!    (plane point o_c, normal n_c toward its child, half-width w_c) gives
+//!    s_c(p) = β(clamp((w_c + n_c·(p − o_c)) / (2 w_c), 0, 1)) on its child side and 0
+//!    elsewhere. The region's joints form a tree (each soft joint under its nearest
+//!    ancestor among them, the bound joint at the root); a node of mass m keeps
+//!    m (1 − min(1, S)) and passes m s_c / max(1, S) to each child c, S = Σ_c s_c. Masses
+//!    are non-negative, sum to m, and are continuous.
+//!
+//!    The child side is not a half-space: it is the set of vertices reached *along the
+//!    surface* from the joint's own cross-section (vertices within the plane's band and
+//!    near the joint) without crossing the far edge of the band (n_c·(p − o_c) ≤ −w_c) or
+//!    leaving the region and its overlaps. A plane through a shoulder therefore never
+//!    reaches a thigh that the hand touches, and a soft boundary acts only inside its own
+//!    region: the surface-distance guarantee of §3.3 holds for soft boundaries too.
+//! 4. **Fallback.** A vertex that no region with joints reaches (a loose piece, a
+//!    degenerate bit, a region without joints) copies the weights of the nearest weighted
+//!    vertex along the surface's edges (Dijkstra) when its component has one, and is bound
+//!    to the nearest bone segment otherwise ([`crate::nearest_bone`]).
+
+use crate::blend::{beta, blend_regions, Blend};
+use crate::geodesic::BandDistances;
+use crate::nearest_bone::{bone_segments, point_segment_distance};
+use crate::overlap::{OverlapParams, Overlaps};
+use crate::{BoundaryKind, Decomposition};
+use atlas_skin_runtime::{Skeleton, VertexWeights};
+use glam::{DVec3, Vec3};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::cmp::Reverse;
+use std::collections::{BinaryHeap, VecDeque};
+use thiserror::Error;
+
+/// Vertices per parallel work item.
+const CHUNK: usize = 2048;
+
+/// What can be wrong with the inputs of the weights stage.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum WeightsError {
+    #[error("overlap factor for unknown joint {name:?}")]
+    UnknownJoint { name: String },
+    #[error("overlap factor {value} {} is not a positive number", joint.as_ref().map_or("(global)".to_string(), |j| format!("for joint {j:?}")))]
+    BadOverlapFactor { joint: Option<String>, value: f64 },
+    #[error("the decomposition refers to joint {joint}, the skeleton has {count} joints")]
+    JointOutOfRange { joint: u32, count: usize },
+    #[error(
+        "the decomposition has {decomposition} joint decisions, the skeleton {skeleton} joints"
+    )]
+    SkeletonMismatch {
+        decomposition: usize,
+        skeleton: usize,
+    },
+    #[error("the decomposition refers to region {region}, it has {count} regions")]
+    RegionOutOfRange { region: u32, count: usize },
+    #[error("the cut curve of joint {joint} uses vertex {vertex}, the surface has {count}")]
+    CurveVertexOutOfRange {
+        joint: u32,
+        vertex: u32,
+        count: usize,
+    },
+    #[error("an overlap band holds vertex {vertex}, the surface has {count}")]
+    BandVertexOutOfRange { vertex: u32, count: usize },
+    #[error("{what}: {found} entries, expected {expected}")]
+    LengthMismatch {
+        what: &'static str,
+        found: usize,
+        expected: usize,
+    },
+    #[error("--max-influences must be at least 1")]
+    NoInfluences,
+}
+
+/// Settings of the weights stage.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct WeightParams {
+    pub overlap: OverlapParams,
+    pub blend: Blend,
+}
+
+/// Weights of every vertex of the split surface, in compressed rows like
+/// [`VertexWeights`]: vertex v's (joint, weight) pairs are at `offsets[v]..offsets[v + 1]`,
+/// weights positive and summing to 1, joints distinct.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SurfaceWeights {
+    pub offsets: Vec<u32>,
+    pub joints: Vec<u32>,
+    pub weights: Vec<f64>,
+}
+
+impl SurfaceWeights {
+    /// Number of vertices.
+    pub fn vertex_count(&self) -> usize {
+        self.offsets.len().saturating_sub(1)
+    }
+
+    /// The (joint, weight) pairs of vertex `v`.
+    pub fn row(&self, v: usize) -> impl Iterator<Item = (u32, f64)> + '_ {
+        let range = self.offsets[v] as usize..self.offsets[v + 1] as usize;
+        self.joints[range.clone()]
+            .iter()
+            .copied()
+            .zip(self.weights[range].iter().copied())
+    }
+
+    fn extend_row(&mut self, row: impl IntoIterator<Item = (u32, f64)>) {
+        for (j, w) in row {
+            self.joints.push(j);
+            self.weights.push(w);
+        }
+        self.offsets.push(self.joints.len() as u32);
+    }
+}
+
+/// What the weights stage could not do as planned, for the report.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+pub struct WeightCounts {
+    /// Surface vertices no region with joints reaches.
+    pub unreachable: usize,
+    /// Of those, vertices weighted from the nearest weighted vertex along the surface.
+    pub from_surface: usize,
+    /// Of those, vertices bound to the nearest bone (no weighted vertex in their component).
+    pub from_bone: usize,
+    /// Joints whose soft boundary is inactive (no cross-section near the joint).
+    pub inactive_soft_joints: Vec<u32>,
+}
+
+/// Weights of every vertex of `decomposition.surface` (module documentation).
+///
+/// - `skeleton`: the decomposed skeleton (#J joints, one decision each).
+/// - `overlaps`: from [`crate::overlap::compute_overlaps`] on the same decomposition.
+pub fn compute_weights(
+    decomposition: &Decomposition,
+    skeleton: &Skeleton,
+    overlaps: &Overlaps,
+    blend: Blend,
+) -> Result<(SurfaceWeights, WeightCounts), WeightsError> {
+    validate(decomposition, skeleton, overlaps)?;
+    let vertex_count = decomposition.surface.vertex_count();
+    let bands = vertex_bands(&overlaps.bands, vertex_count);
+    let related = related_regions(decomposition, overlaps, &bands);
+    let softs = soft_sides(decomposition, overlaps, &related);
+    let trees = region_trees(decomposition, skeleton, &softs);
+    let mut weights = blend_vertices(decomposition, &related, &softs, &trees, blend);
+    let mut counts = fill_unweighted(decomposition, skeleton, &mut weights);
+    counts.inactive_soft_joints = decomposition
+        .boundaries
+        .iter()
+        .filter(|b| b.kind == BoundaryKind::Soft && !softs.iter().any(|s| s.joint == b.joint))
+        .map(|b| b.joint)
+        .collect();
+    Ok((weights, counts))
+}
+
+fn validate(
+    decomposition: &Decomposition,
+    skeleton: &Skeleton,
+    overlaps: &Overlaps,
+) -> Result<(), WeightsError> {
+    let d = decomposition;
+    let length = |what, found, expected| {
+        if found == expected {
+            Ok(())
+        } else {
+            Err(WeightsError::LengthMismatch {
+                what,
+                found,
+                expected,
+            })
+        }
+    };
+    if d.joints.len() != skeleton.len() {
+        return Err(WeightsError::SkeletonMismatch {
+            decomposition: d.joints.len(),
+            skeleton: skeleton.len(),
+        });
+    }
+    length(
+        "face regions",
+        d.face_region.len(),
+        d.surface.triangle_count(),
+    )?;
+    length(
+        "overlap widths",
+        overlaps.half_widths.len(),
+        d.boundaries.len(),
+    )?;
+    length("overlap bands", overlaps.bands.len(), d.boundaries.len())?;
+    length(
+        "topology vertices",
+        d.topology.vertex_face_offsets.len().saturating_sub(1),
+        d.surface.vertex_count(),
+    )?;
+    let region_count = d.regions.len();
+    let region_ok = |region: u32| {
+        if (region as usize) < region_count {
+            Ok(())
+        } else {
+            Err(WeightsError::RegionOutOfRange {
+                region,
+                count: region_count,
+            })
+        }
+    };
+    let joint_ok = |joint: u32| {
+        if (joint as usize) < skeleton.len() {
+            Ok(())
+        } else {
+            Err(WeightsError::JointOutOfRange {
+                joint,
+                count: skeleton.len(),
+            })
+        }
+    };
+    for &r in &d.face_region {
+        region_ok(r)?;
+    }
+    for b in &d.boundaries {
+        region_ok(b.parent_region)?;
+        region_ok(b.child_region)?;
+        joint_ok(b.joint)?;
+    }
+    for r in &d.regions {
+        for &j in &r.joints {
+            joint_ok(j)?;
+        }
+    }
+    for band in &overlaps.bands {
+        if let Some(&v) = band
+            .vertices
+            .iter()
+            .find(|&&v| v as usize >= d.surface.vertex_count())
+        {
+            return Err(WeightsError::BandVertexOutOfRange {
+                vertex: v,
+                count: d.surface.vertex_count(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Compressed rows over `0..n`: row v is `values[offsets[v]..offsets[v + 1]]`.
+struct Rows<T> {
+    offsets: Vec<u32>,
+    values: Vec<T>,
+}
+
+impl<T> Rows<T> {
+    fn row(&self, v: usize) -> &[T] {
+        &self.values[self.offsets[v] as usize..self.offsets[v + 1] as usize]
+    }
+}
+
+/// Builds rows over `0..n` in parallel: `fill(v, scratch, out)` appends row v's values to
+/// `out`; `scratch` is working memory reused within a chunk of vertices.
+fn par_rows<S: Default, T: Send>(
+    n: usize,
+    fill: impl Fn(usize, &mut S, &mut Vec<T>) + Sync,
+) -> Rows<T> {
+    let chunks: Vec<(Vec<u32>, Vec<T>)> = (0..n.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|chunk| {
+            let range = chunk * CHUNK..((chunk + 1) * CHUNK).min(n);
+            let mut lengths = Vec::with_capacity(range.len());
+            let mut values = Vec::new();
+            let mut scratch = S::default();
+            for v in range {
+                let before = values.len();
+                fill(v, &mut scratch, &mut values);
+                lengths.push((values.len() - before) as u32);
+            }
+            (lengths, values)
+        })
+        .collect();
+    let mut offsets = Vec::with_capacity(n + 1);
+    offsets.push(0u32);
+    let mut values = Vec::with_capacity(chunks.iter().map(|c| c.1.len()).sum());
+    for (lengths, chunk_values) in chunks {
+        for length in lengths {
+            offsets.push(offsets[offsets.len() - 1] + length);
+        }
+        values.extend(chunk_values);
+    }
+    Rows { offsets, values }
+}
+
+/// Per vertex, the (boundary, surface distance) of every cut band that reaches it.
+fn vertex_bands(bands: &[BandDistances], vertex_count: usize) -> Rows<(u32, f64)> {
+    let mut offsets = vec![0u32; vertex_count + 1];
+    for band in bands {
+        for &v in &band.vertices {
+            offsets[v as usize + 1] += 1;
+        }
+    }
+    for v in 0..vertex_count {
+        offsets[v + 1] += offsets[v];
+    }
+    let mut fill = offsets.clone();
+    let mut values = vec![(0u32, 0.0); offsets[vertex_count] as usize];
+    for (k, band) in bands.iter().enumerate() {
+        for (&v, &d) in band.vertices.iter().zip(&band.distances) {
+            values[fill[v as usize] as usize] = (k as u32, d);
+            fill[v as usize] += 1;
+        }
+    }
+    Rows { offsets, values }
+}
+
+/// Step 1: per vertex, the (region, λ) of its related regions that hold joints.
+fn related_regions(
+    decomposition: &Decomposition,
+    overlaps: &Overlaps,
+    bands: &Rows<(u32, f64)>,
+) -> Rows<(u32, f64)> {
+    let d = decomposition;
+    par_rows(d.surface.vertex_count(), |v, _: &mut (), out| {
+        let start = out.len();
+        for &f in d.topology.faces_of_vertex(v) {
+            let region = d.face_region[f as usize];
+            if !out[start..].iter().any(|&(r, _)| r == region) {
+                out.push((region, f64::INFINITY));
+            }
+        }
+        let inside = out.len();
+        for &(k, g) in bands.row(v) {
+            let boundary = &d.boundaries[k as usize];
+            let w = overlaps.half_widths[k as usize].max(f64::MIN_POSITIVE);
+            for region in [boundary.parent_region, boundary.child_region] {
+                match out[start..].iter().position(|&(r, _)| r == region) {
+                    Some(i) if start + i < inside => {
+                        let depth = &mut out[start + i].1;
+                        *depth = depth.min((w + g) / (2.0 * w));
+                    }
+                    Some(i) => {
+                        let depth = &mut out[start + i].1;
+                        *depth = depth.max((w - g) / (2.0 * w));
+                    }
+                    None => out.push((region, (w - g) / (2.0 * w))),
+                }
+            }
+        }
+        let mut keep = start;
+        for i in start..out.len() {
+            let (region, depth) = out[i];
+            if depth > 0.0 && !d.regions[region as usize].joints.is_empty() {
+                out[keep] = (region, depth);
+                keep += 1;
+            }
+        }
+        out.truncate(keep);
+    })
+}
+
+/// A soft boundary, ready for step 3.
+struct SoftSide {
+    joint: u32,
+    region: u32,
+    point: DVec3,
+    normal: DVec3,
+    half_width: f64,
+    /// Bit v set when vertex v is on the child side reached along the surface.
+    reached: Vec<u64>,
+}
+
+impl SoftSide {
+    /// s_c(p) of the module documentation.
+    fn share(&self, v: usize, position: DVec3) -> f64 {
+        if self.reached[v / 64] & (1 << (v % 64)) == 0 {
+            return 0.0;
+        }
+        let signed = self.normal.dot(position - self.point);
+        let w = self.half_width.max(f64::MIN_POSITIVE);
+        beta(((w + signed) / (2.0 * w)).clamp(0.0, 1.0))
+    }
+}
+
+/// Step 3's child sides: for each soft boundary, a flood along edges from the vertices of
+/// the joint's cross-section (within the band |n·(p − o)| ≤ w and within max(D, w) of the
+/// joint), through vertices related to the boundary's region whose signed plane distance
+/// exceeds −w. A soft boundary with no cross-section (diameter 0, or no band vertex near
+/// the joint: face bones in a mouth cavity or an eye socket) is inactive: its joint gets
+/// no weight and its region's other joints keep it.
+fn soft_sides(
+    decomposition: &Decomposition,
+    overlaps: &Overlaps,
+    related: &Rows<(u32, f64)>,
+) -> Vec<SoftSide> {
+    let d = decomposition;
+    let positions = &d.surface.positions;
+    let vertex_count = d.surface.vertex_count();
+    // Transpose of `related`: the vertices each region reaches.
+    let mut region_vertices: Vec<Vec<u32>> = vec![Vec::new(); d.regions.len()];
+    for v in 0..vertex_count {
+        for &(r, _) in related.row(v) {
+            region_vertices[r as usize].push(v as u32);
+        }
+    }
+    d.boundaries
+        .par_iter()
+        .enumerate()
+        .filter(|(_, b)| b.kind == BoundaryKind::Soft && b.diameter > 0.0)
+        .filter_map(|(k, b)| {
+            let half_width = overlaps.half_widths[k];
+            let signed = |v: usize| b.normal.dot(positions[v] - b.point);
+            let in_domain = |v: usize| {
+                signed(v) > -half_width && related.row(v).iter().any(|&(r, _)| r == b.parent_region)
+            };
+            let mut reached = vec![0u64; vertex_count.div_ceil(64)];
+            let mut queue = VecDeque::new();
+            let seed_radius = b.diameter.max(half_width);
+            let candidates = &region_vertices[b.parent_region as usize];
+            let in_section = |&&v: &&u32| signed(v as usize) <= half_width && in_domain(v as usize);
+            let seeds: Vec<u32> = candidates
+                .iter()
+                .filter(in_section)
+                .filter(|&&v| positions[v as usize].distance(b.point) <= seed_radius)
+                .copied()
+                .collect();
+            if seeds.is_empty() {
+                return None;
+            }
+            for v in seeds {
+                reached[v as usize / 64] |= 1 << (v % 64);
+                queue.push_back(v);
+            }
+            while let Some(v) = queue.pop_front() {
+                for &u in d.topology.neighbors(v as usize) {
+                    let (word, bit) = (u as usize / 64, 1u64 << (u % 64));
+                    if reached[word] & bit == 0 && in_domain(u as usize) {
+                        reached[word] |= bit;
+                        queue.push_back(u);
+                    }
+                }
+            }
+            Some(SoftSide {
+                joint: b.joint,
+                region: b.parent_region,
+                point: b.point,
+                normal: b.normal,
+                half_width,
+                reached,
+            })
+        })
+        .collect()
+}
+
+/// The joints of one region as a tree for step 3: node 0 is the bound joint, node i > 0
+/// the soft boundary `softs[i − 1]`; nodes listed parents first.
+#[derive(Debug, Default)]
+struct RegionTree {
+    joints: Vec<u32>,
+    /// Index into the `softs` vector of every node after the root.
+    softs: Vec<usize>,
+    children: Vec<Vec<usize>>,
+    order: Vec<usize>,
+}
+
+fn region_trees(
+    decomposition: &Decomposition,
+    skeleton: &Skeleton,
+    softs: &[SoftSide],
+) -> Vec<RegionTree> {
+    decomposition
+        .regions
+        .iter()
+        .enumerate()
+        .map(|(r, region)| {
+            let Some(&bound) = region.joints.first() else {
+                return RegionTree::default();
+            };
+            let mut tree = RegionTree {
+                joints: vec![bound],
+                ..RegionTree::default()
+            };
+            for (s, soft) in softs.iter().enumerate() {
+                if soft.region as usize == r && soft.joint != bound {
+                    tree.joints.push(soft.joint);
+                    tree.softs.push(s);
+                }
+            }
+            tree.children = vec![Vec::new(); tree.joints.len()];
+            for node in 1..tree.joints.len() {
+                let mut ancestor = skeleton.parent(tree.joints[node] as usize);
+                let parent = loop {
+                    match ancestor {
+                        None => break 0,
+                        Some(a) => match tree.joints.iter().position(|&j| j as usize == a) {
+                            Some(p) => break p,
+                            None => ancestor = skeleton.parent(a),
+                        },
+                    }
+                };
+                tree.children[parent].push(node);
+            }
+            tree.order = vec![0];
+            let mut i = 0;
+            while i < tree.order.len() {
+                let node = tree.order[i];
+                tree.order.extend(tree.children[node].iter().copied());
+                i += 1;
+            }
+            tree
+        })
+        .collect()
+}
+
+/// Per-chunk working memory of [`blend_vertices`].
+#[derive(Default)]
+struct BlendScratch {
+    depths: Vec<f64>,
+    region_weights: Vec<f64>,
+    mass: Vec<f64>,
+}
+
+/// Steps 2 and 3 for every vertex.
+fn blend_vertices(
+    decomposition: &Decomposition,
+    related: &Rows<(u32, f64)>,
+    softs: &[SoftSide],
+    trees: &[RegionTree],
+    blend: Blend,
+) -> SurfaceWeights {
+    let positions = &decomposition.surface.positions;
+    let rows = par_rows(positions.len(), |v, scratch: &mut BlendScratch, out| {
+        let regions = related.row(v);
+        scratch.depths.clear();
+        scratch.depths.extend(regions.iter().map(|&(_, l)| l));
+        scratch.region_weights.clear();
+        scratch.region_weights.resize(regions.len(), 0.0);
+        blend_regions(blend, &scratch.depths, &mut scratch.region_weights);
+        let start = out.len();
+        for (&(r, _), &omega) in regions.iter().zip(&scratch.region_weights) {
+            let tree = &trees[r as usize];
+            let mass = &mut scratch.mass;
+            mass.clear();
+            mass.resize(tree.joints.len(), 0.0);
+            mass[0] = omega;
+            for &node in &tree.order {
+                let m = mass[node];
+                if m <= 0.0 {
+                    continue;
+                }
+                let share = |c: usize| softs[tree.softs[c - 1]].share(v, positions[v]);
+                let total: f64 = tree.children[node].iter().map(|&c| share(c)).sum();
+                for &c in &tree.children[node] {
+                    mass[c] = m * share(c) / total.max(1.0);
+                }
+                mass[node] = m * (1.0 - total.min(1.0));
+            }
+            for (&joint, &m) in tree.joints.iter().zip(mass.iter()) {
+                if m <= 0.0 {
+                    continue;
+                }
+                match out[start..].iter_mut().find(|(j, _)| *j == joint) {
+                    Some(entry) => entry.1 += m,
+                    None => out.push((joint, m)),
+                }
+            }
+        }
+    });
+    let (joints, weights) = rows.values.into_iter().unzip();
+    SurfaceWeights {
+        offsets: rows.offsets,
+        joints,
+        weights,
+    }
+}
+
+/// Step 4: gives every vertex without weights the weights of the nearest weighted vertex
+/// along the edges, or of the nearest bone; returns the counts.
+fn fill_unweighted(
+    decomposition: &Decomposition,
+    skeleton: &Skeleton,
+    weights: &mut SurfaceWeights,
+) -> WeightCounts {
+    let n = weights.vertex_count();
+    let empty = |v: usize| weights.offsets[v] == weights.offsets[v + 1];
+    let unreachable = (0..n).filter(|&v| empty(v)).count();
+    if unreachable == 0 {
+        return WeightCounts::default();
+    }
+    // Multi-source Dijkstra along edges from every weighted vertex; `source[v]` is the
+    // weighted vertex whose row v copies.
+    let positions = &decomposition.surface.positions;
+    let mut source = vec![u32::MAX; n];
+    let mut distance = vec![f64::INFINITY; n];
+    let mut heap = BinaryHeap::new();
+    for v in (0..n).filter(|&v| !empty(v)) {
+        source[v] = v as u32;
+        distance[v] = 0.0;
+        heap.push((Reverse(OrderedDistance(0.0)), v as u32));
+    }
+    while let Some((Reverse(OrderedDistance(dv)), v)) = heap.pop() {
+        let v = v as usize;
+        if dv > distance[v] {
+            continue;
+        }
+        for &u in decomposition.topology.neighbors(v) {
+            let du = dv + positions[v].distance(positions[u as usize]);
+            if du < distance[u as usize] {
+                distance[u as usize] = du;
+                source[u as usize] = source[v];
+                heap.push((Reverse(OrderedDistance(du)), u));
+            }
+        }
+    }
+    let segments = bone_segments(skeleton);
+    let mut counts = WeightCounts {
+        unreachable,
+        ..WeightCounts::default()
+    };
+    let mut filled = SurfaceWeights {
+        offsets: vec![0],
+        ..SurfaceWeights::default()
+    };
+    for v in 0..n {
+        if !empty(v) {
+            filled.extend_row(weights.row(v));
+        } else if source[v] != u32::MAX {
+            counts.from_surface += 1;
+            filled.extend_row(weights.row(source[v] as usize));
+        } else {
+            counts.from_bone += 1;
+            filled.extend_row(nearest_bone(&segments, positions[v]).map(|j| (j, 1.0)));
+        }
+    }
+    *weights = filled;
+    counts
+}
+
+/// The joint owning the bone segment nearest to `p` (`segments` from [`bone_segments`]).
+fn nearest_bone(segments: &[(u32, DVec3, DVec3)], p: DVec3) -> Option<u32> {
+    segments
+        .iter()
+        .map(|&(j, a, b)| (j, point_segment_distance(p, a, b)))
+        .min_by(|x, y| x.1.total_cmp(&y.1))
+        .map(|(j, _)| j)
+}
+
+/// An f64 distance ordered by `total_cmp`, for the heap.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct OrderedDistance(f64);
+
+impl Eq for OrderedDistance {}
+
+impl PartialOrd for OrderedDistance {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for OrderedDistance {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&other.0)
+    }
+}
+
+/// Weights per stored vertex of the input mesh: surface vertex `welded_of_stored[s]` for
+/// stored vertex s (the split surface starts with the welded vertices), keeping the
+/// `max_influences` largest weights and rescaling them to sum to 1. A stored vertex no
+/// triangle uses ([`crate::weld::UNREFERENCED`]) is bound to its nearest bone.
+///
+/// - `surface_weights`: from [`compute_weights`].
+/// - `welded_of_stored`, `stored_positions`: #stored entries ([`crate::Welded`] and the
+///   input mesh).
+pub fn stored_weights(
+    surface_weights: &SurfaceWeights,
+    welded_of_stored: &[u32],
+    stored_positions: &[Vec3],
+    skeleton: &Skeleton,
+    max_influences: usize,
+) -> Result<VertexWeights, WeightsError> {
+    if max_influences == 0 {
+        return Err(WeightsError::NoInfluences);
+    }
+    if stored_positions.len() != welded_of_stored.len() {
+        return Err(WeightsError::LengthMismatch {
+            what: "stored positions",
+            found: stored_positions.len(),
+            expected: welded_of_stored.len(),
+        });
+    }
+    let segments = bone_segments(skeleton);
+    let rows: Vec<Vec<(u32, f32)>> = welded_of_stored
+        .par_iter()
+        .zip(stored_positions)
+        .map(|(&w, &p)| {
+            let mut row: Vec<(u32, f64)> = if (w as usize) < surface_weights.vertex_count() {
+                surface_weights.row(w as usize).collect()
+            } else {
+                nearest_bone(&segments, p.as_dvec3())
+                    .map(|j| (j, 1.0))
+                    .into_iter()
+                    .collect()
+            };
+            row.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+            row.truncate(max_influences);
+            let total: f64 = row.iter().map(|&(_, x)| x).sum();
+            row.into_iter()
+                .filter(|_| total > 0.0)
+                .map(|(j, x)| (j, (x / total) as f32))
+                .collect()
+        })
+        .collect();
+    Ok(VertexWeights::from_rows(rows))
+}

@@ -1,0 +1,237 @@
+//! Decomposition of the real characters of `../shared/data/models`.
+//!
+//! Every closed genus-0 model: regions = cuts + 1, every face in a region, no two curves
+//! crossing or touching, its elbows, knees, wrists and ankles cut (by name where the file
+//! names them, by the manifest's structure otherwise), and no joint inside the mesh without
+//! a boundary unless it owns no geometry (root, branching joint on the mirror plane, end
+//! site). The open strip simpleskin finishes with a reason for every joint.
+
+mod decompose_checks;
+
+use atlas_skin::weld::DEFAULT_WELD_TOLERANCE;
+use atlas_skin::winding::winding_number;
+use atlas_skin::{
+    decompose, weld, DecomposeParams, Decomposition, JointStatus, SurfaceMesh, Topology,
+};
+use atlas_skin_io::{load_character, LoadOptions};
+use atlas_skin_runtime::Skeleton;
+use decompose_checks::check_decomposition;
+use std::path::PathBuf;
+
+const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data");
+
+/// A corpus model: its main file, skeleton file and OBJ group when it needs them.
+struct Model {
+    folder: &'static str,
+    file: &'static str,
+    skeleton: Option<&'static str>,
+    group: Option<&'static str>,
+}
+
+fn load(model: &Model) -> (SurfaceMesh, Skeleton) {
+    let folder = PathBuf::from(DATA).join("models").join(model.folder);
+    assert!(
+        folder.is_dir(),
+        "missing corpus folder {}",
+        folder.display()
+    );
+    let options = LoadOptions {
+        skeleton: model.skeleton.map(|s| folder.join(s)),
+        group: model.group.map(str::to_string),
+        ..Default::default()
+    };
+    let character = load_character(&folder.join(model.file), &options)
+        .unwrap_or_else(|e| panic!("{}: {e}", model.folder));
+    let welded = weld(
+        &character.mesh.positions,
+        &character.mesh.triangles,
+        DEFAULT_WELD_TOLERANCE,
+    );
+    let skeleton = character.skeleton.expect("the model has a skeleton");
+    (welded.mesh, skeleton)
+}
+
+/// Reasons for which a joint inside the mesh may have no boundary: it owns no geometry.
+const NO_GEOMETRY: [&str; 3] = [
+    "root joint",
+    "branching joint on the mirror plane",
+    "end site",
+];
+
+/// Decomposes a closed genus-0 model, checks the invariants and that `required` joints
+/// are cut; prints the report's summary.
+fn check_closed_model(model: &Model, required: &[&str]) -> Decomposition {
+    let (mesh, skeleton) = load(model);
+    let factor: f64 = std::env::var("PROBE_FACTOR").ok().and_then(|v| v.parse().ok()).unwrap_or(4.0);
+    let d = decompose(
+        &mesh,
+        &Topology::new(&mesh),
+        &skeleton,
+        &DecomposeParams { neighbourhood_factor: factor, ..Default::default() },
+    )
+    .expect("decomposes");
+    let cuts = check_decomposition(&d, true);
+    let positions = skeleton.bind_positions();
+    for (j, decision) in d.joints.iter().enumerate() {
+        eprintln!(
+            "{}: {} {:?} region {:?}",
+            model.folder, decision.name, decision.status, decision.region
+        );
+        let inside = winding_number(&mesh, positions[j].as_dvec3()).abs() > 0.5;
+        if let (true, JointStatus::Skipped(reason)) = (inside, &decision.status) {
+            assert!(
+                NO_GEOMETRY.iter().any(|r| reason.starts_with(r)),
+                "{}: {} is inside the mesh but has no boundary: {reason}",
+                model.folder,
+                decision.name
+            );
+        }
+    }
+    for name in required {
+        let decision = d
+            .joints
+            .iter()
+            .find(|j| j.name == *name)
+            .unwrap_or_else(|| panic!("{}: no joint {name}", model.folder));
+        assert_eq!(
+            decision.status,
+            JointStatus::Cut,
+            "{}: {name} is not cut",
+            model.folder
+        );
+    }
+    let report = d.report();
+    eprintln!(
+        "{}: {} cuts, {} soft, {} skipped, {} regions",
+        model.folder,
+        cuts,
+        report.soft,
+        report.skipped,
+        d.regions.len()
+    );
+    d
+}
+
+#[test]
+fn riggedsimple_cuts_its_leaf_joint() {
+    let model = Model {
+        folder: "riggedsimple",
+        file: "RiggedSimple.glb",
+        skeleton: None,
+        group: None,
+    };
+    let d = check_closed_model(&model, &["node3"]);
+    assert_eq!(d.regions.len(), 2);
+}
+
+/// RiggedFigure and CesiumMan share the node layout (manifest `khronos_name`): elbows
+/// node17/node14, wrists node18/node15, knees node8/node4, ankles node9/node5.
+const FIGURE_LIMB_JOINTS: [&str; 8] = [
+    "node17", "node14", "node18", "node15", "node8", "node4", "node9", "node5",
+];
+
+#[test]
+fn riggedfigure_cuts_every_limb_joint() {
+    let model = Model {
+        folder: "riggedfigure",
+        file: "RiggedFigure.glb",
+        skeleton: None,
+        group: None,
+    };
+    check_closed_model(&model, &FIGURE_LIMB_JOINTS);
+}
+
+#[test]
+fn cesiumman_cuts_every_limb_joint() {
+    let model = Model {
+        folder: "cesiumman",
+        file: "CesiumMan.glb",
+        skeleton: None,
+        group: None,
+    };
+    check_closed_model(&model, &FIGURE_LIMB_JOINTS);
+}
+
+#[test]
+fn arm_cuts_its_chain() {
+    let model = Model {
+        folder: "arm",
+        file: "arm.obj",
+        skeleton: Some("arm.tgf"),
+        group: None,
+    };
+    check_closed_model(&model, &["tgf_2", "tgf_3", "tgf_4"]);
+}
+
+#[test]
+fn hand_cuts_its_fingers() {
+    let model = Model {
+        folder: "hand",
+        file: "hand.mesh",
+        skeleton: Some("hand.tgf"),
+        group: None,
+    };
+    check_closed_model(&model, &[]);
+}
+
+#[test]
+fn elephant_cuts_its_limbs() {
+    let model = Model {
+        folder: "elephant",
+        file: "elephant.obj",
+        skeleton: Some("elephant.tgf"),
+        group: None,
+    };
+    check_closed_model(&model, &[]);
+}
+
+#[test]
+fn makehuman_body_cuts_every_limb_joint() {
+    let model = Model {
+        folder: "makehuman",
+        file: "base.obj",
+        skeleton: Some("default.mhskel"),
+        group: Some("body"),
+    };
+    check_closed_model(
+        &model,
+        &[
+            "lowerarm01.L",
+            "lowerarm01.R",
+            "wrist.L",
+            "wrist.R",
+            "lowerleg01.L",
+            "lowerleg01.R",
+            "foot.L",
+            "foot.R",
+        ],
+    );
+}
+
+#[test]
+fn simpleskin_open_strip_finishes_with_reasons() {
+    let model = Model {
+        folder: "simpleskin",
+        file: "SimpleSkin.gltf",
+        skeleton: None,
+        group: None,
+    };
+    let (mesh, skeleton) = load(&model);
+    let d = decompose(
+        &mesh,
+        &Topology::new(&mesh),
+        &skeleton,
+        &DecomposeParams::default(),
+    )
+    .expect("decomposes");
+    check_decomposition(&d, false);
+    assert_eq!(d.joints.len(), 2);
+    assert!(d
+        .joints
+        .iter()
+        .all(|j| !matches!(j.status, JointStatus::Cut)));
+    let report = serde_json::to_value(d.report()).expect("serialisable");
+    for joint in report["joints"].as_array().expect("joints") {
+        assert!(joint["reason"].is_string(), "{joint}");
+    }
+}

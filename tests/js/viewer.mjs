@@ -1,0 +1,140 @@
+// Browser test of an atlas-skin HTML report in Debian's headless Chromium.
+//
+//   node tests/js/viewer.mjs REPORT.html SCREENSHOT_PREFIX
+//
+// Opens the report from file://, records console errors, page errors and every network
+// request other than the file itself and data: URLs, then checks through the viewer's test
+// hook (window.atlasViewer) that the canvas is not blank, that moving a joint slider, the
+// weight heat map and the animation time change the pixels, that the LBS/DQS switch switches
+// (checks.dqs_changed_fraction: how much of the picture it changed), that a hovered joint
+// shows its name and a clicked one is selected. checks.skinning_probe holds GPU-skinned
+// positions (LBS and DQS) of the posed model with the weights and palette that made them. Saves screenshots
+// SCREENSHOT_PREFIX-{regions,weights,pose-lbs,pose-dqs}.png and prints one JSON
+// object: { failures: [...], checks: {...}, screenshots: [...] }; checks.half_time_poses
+// holds, per animation, the animated node values at half its duration.
+import { chromium } from 'playwright-core';
+import { mkdtempSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join, resolve } from 'node:path';
+import { pathToFileURL } from 'node:url';
+
+const [reportPath, screenshotPrefix] = process.argv.slice(2);
+if (!reportPath || !screenshotPrefix) {
+  console.error('usage: node viewer.mjs REPORT.html SCREENSHOT_PREFIX');
+  process.exit(2);
+}
+const fileUrl = pathToFileURL(resolve(reportPath)).href;
+const failures = [];
+const checks = {};
+const screenshots = [];
+
+// Fraction of thumbnail samples that differ by more than 8 grey levels.
+const changed = (a, b) => a.filter((v, i) => Math.abs(v - b[i]) > 8).length / a.length;
+
+const userDataDir = mkdtempSync(join(tmpdir(), 'atlas-skin-chromium-'));
+const context = await chromium.launchPersistentContext(userDataDir, {
+  executablePath: '/usr/bin/chromium',
+  headless: true,
+  viewport: { width: 1280, height: 800 },
+  args: [
+    '--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+    '--disable-background-networking', '--disable-component-update', '--disable-sync',
+    '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
+  ],
+});
+try {
+  context.on('request', (request) => {
+    const url = request.url();
+    if (url !== fileUrl && !url.startsWith('data:')) failures.push(`network request: ${url}`);
+  });
+  const page = context.pages()[0] || (await context.newPage());
+  // SwiftShader on a loaded 2-core machine can be slow: generous limits, never a hang.
+  page.setDefaultTimeout(120000);
+  page.on('console', (message) => {
+    if (message.type() === 'error') failures.push(`console error: ${message.text()}`);
+  });
+  page.on('pageerror', (error) => failures.push(`page error: ${error.message}`));
+
+  await page.goto(fileUrl);
+  await page.waitForFunction(() => window.atlasViewer && (window.atlasViewer.ready || window.atlasViewer.error), null, { timeout: 120000 });
+  const error = await page.evaluate(() => window.atlasViewer.error);
+  if (error) throw new Error(`viewer error: ${error}`);
+  const thumbnail = () => page.evaluate(() => window.atlasViewer.thumbnail());
+  const shoot = async (name) => {
+    const path = `${screenshotPrefix}-${name}.png`;
+    await page.screenshot({ path });
+    screenshots.push(path);
+  };
+
+  // Not blank: enough samples away from the background and some spread of grey levels.
+  const rest = await thumbnail();
+  const background = rest[0];
+  const mean = rest.reduce((s, v) => s + v, 0) / rest.length;
+  checks.foreground_fraction = rest.filter((v) => Math.abs(v - background) > 8).length / rest.length;
+  checks.grey_variance = rest.reduce((s, v) => s + (v - mean) ** 2, 0) / rest.length;
+  if (checks.foreground_fraction < 0.02 || checks.grey_variance < 10) failures.push('the canvas is blank');
+  await shoot('regions');
+
+  // Hover a joint that stands apart from the others: its name shows; a click selects it.
+  const screen = await page.evaluate(() => window.atlasViewer.joints().map((j) => window.atlasViewer.projectJoint(j.index)));
+  const apart = screen.findIndex((p, j) => p && screen.every((q, k) => k === j || !q || Math.hypot(p.x - q.x, p.y - q.y) > 14));
+  if (apart < 0) {
+    failures.push('no joint stands apart on screen to hover');
+  } else {
+    const names = await page.evaluate(() => window.atlasViewer.joints().map((j) => j.name));
+    await page.mouse.move(screen[apart].x, screen[apart].y);
+    checks.hover_name = await page.locator('#tip').textContent();
+    if (!(await page.locator('#tip').isVisible()) || checks.hover_name !== names[apart]) failures.push(`hovering joint ${names[apart]} showed "${checks.hover_name}"`);
+    await page.mouse.click(screen[apart].x, screen[apart].y);
+    if ((await page.locator('#joint').inputValue()) !== String(apart)) failures.push('clicking a joint did not select it');
+  }
+  checks.curve_segments = await page.evaluate(() => window.atlasViewer.curveSegments);
+  checks.report_tables = await page.locator('#report table').count();
+  checks.report_rows = await page.locator('#report tr').count();
+
+  // The weights of the joint that dominates the most vertices, then bend that joint.
+  const joints = await page.evaluate(() => window.atlasViewer.joints());
+  const joint = joints.reduce((a, b) => (b.vertices > a.vertices ? b : a));
+  checks.posed_joint = joint.name;
+  await page.selectOption('#joint', String(joint.index));
+  await page.check('#colour-weights');
+  checks.heat_map_changed_fraction = changed(rest, await thumbnail());
+  if (checks.heat_map_changed_fraction < 0.005) failures.push('the weight heat map did not change the picture');
+  await shoot('weights');
+  await page.check('#colour-regions');
+
+  await page.locator('#rot-x').fill('90');
+  await page.locator('#rot-z').fill('45');
+  const posed = await thumbnail();
+  checks.slider_changed_fraction = changed(rest, posed);
+  checks.skinning_probe = await page.evaluate(() => window.atlasViewer.skinningProbe());
+  if (checks.slider_changed_fraction < 0.005) failures.push('moving a joint slider did not change the picture');
+  await shoot('pose-lbs');
+
+  await page.check('#method-dqs');
+  const dqs = await thumbnail();
+  checks.dqs_enabled = await page.evaluate(() => window.atlasViewer.state.dqs);
+  checks.dqs_changed_fraction = changed(posed, dqs);
+  if (!checks.dqs_enabled) failures.push('the DQS switch did not switch');
+  if (dqs.filter((v) => Math.abs(v - background) > 8).length / dqs.length < 0.02) failures.push('the canvas is blank under DQS');
+  await shoot('pose-dqs');
+
+  await page.click('#reset-pose');
+  checks.animations = await page.locator('#animation option').count() - 1;
+  if (checks.animations > 0) {
+    await page.selectOption('#animation', '0');
+    const start = await thumbnail();
+    await page.locator('#time').fill('0.5');
+    checks.animation_changed_fraction = changed(start, await thumbnail());
+    if (checks.animation_changed_fraction < 0.002) failures.push('the animation time slider did not change the picture');
+  }
+  checks.half_time_poses = await page.evaluate(() => window.atlasViewer.animations().map((a, i) => window.atlasViewer.poseAt(i, a.duration / 2)));
+  checks.gl_error = await page.evaluate(() => window.atlasViewer.glError());
+  if (checks.gl_error !== 0) failures.push(`WebGL error ${checks.gl_error}`);
+} catch (error) {
+  failures.push(String(error && error.stack ? error.stack : error));
+} finally {
+  await context.close();
+  rmSync(userDataDir, { recursive: true, force: true });
+}
+console.log(JSON.stringify({ failures, checks, screenshots }, null, 1));
