@@ -34,11 +34,48 @@ impl InputArgs {
     /// Reads the character, or builds the demo character when no input is given.
     pub fn load(&self) -> Result<Character> {
         match &self.input {
-            Some(path) => atlas_skin_io::load_character(path, &self.load_options())
-                .with_context(|| format!("cannot load {}", path.display())),
+            // The reader's errors name the file already.
+            Some(path) => Ok(atlas_skin_io::load_character(path, &self.load_options())?),
             None => Ok(demo_character()),
         }
     }
+
+    /// As [`InputArgs::load`], with the demo character skinned by the method
+    /// ([`skin_character`]): what the commands that deform a character (`pose`, `animate`,
+    /// `bench`) read. A given input keeps its own weights (or lack of them).
+    pub fn load_skinned(&self) -> Result<Character> {
+        let mut character = self.load()?;
+        if self.input.is_none() {
+            skin_character(&mut character)?;
+        }
+        Ok(character)
+    }
+}
+
+/// Sets `character`'s weights to those the method computes with its default settings
+/// ([`atlas_skin::pipeline::skin`], as `atlas-skin skin` without options).
+pub fn skin_character(character: &mut Character) -> Result<()> {
+    let skeleton = character
+        .skeleton
+        .as_ref()
+        .with_context(|| format!("{} has no skeleton", character.path.display()))?;
+    let welded = weld(
+        &character.mesh.positions,
+        &character.mesh.triangles,
+        atlas_skin::weld::DEFAULT_WELD_TOLERANCE,
+    );
+    let topology = Topology::new(&welded.mesh);
+    let skinned = atlas_skin::pipeline::skin(
+        &welded,
+        &topology,
+        &character.mesh.positions,
+        skeleton,
+        &atlas_skin::pipeline::SkinParams::default(),
+        &mut |_| {},
+    )
+    .with_context(|| format!("cannot skin {}", character.path.display()))?;
+    character.reference_weights = Some(skinned.weights);
+    Ok(())
 }
 
 /// The built-in demo character ([`atlas_skin::demo`]) as if read from a file named

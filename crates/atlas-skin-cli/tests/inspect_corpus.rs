@@ -19,7 +19,10 @@ fn model_file(model: &str, file: &str) -> PathBuf {
 /// manifest.
 fn check(model: &str, mesh: &str, skeleton: Option<&str>, group: Option<&str>) {
     let mut command = Command::new(env!("CARGO_BIN_EXE_atlas-skin"));
-    command.arg("inspect").arg("--json").arg(model_file(model, mesh));
+    command
+        .arg("inspect")
+        .arg("--json")
+        .arg(model_file(model, mesh));
     if let Some(skeleton) = skeleton {
         command.arg("--skeleton").arg(model_file(model, skeleton));
     }
@@ -47,14 +50,20 @@ fn check(model: &str, mesh: &str, skeleton: Option<&str>, group: Option<&str>) {
     let joints = report["joints"].as_array().expect("joints");
     let expected = manifest["joints"].as_array().unwrap();
     assert_eq!(joints.len(), expected.len(), "{model}: joint count");
-    assert_eq!(joints.len() as u64, manifest["joint_count"].as_u64().unwrap());
+    assert_eq!(
+        joints.len() as u64,
+        manifest["joint_count"].as_u64().unwrap()
+    );
     for joint in expected {
         let name = &joint["name"];
         let found = joints
             .iter()
             .find(|j| &j["name"] == name)
             .unwrap_or_else(|| panic!("{model}: no joint {name}"));
-        assert_eq!(found["inside"], joint["inside_mesh"], "{model}: {name} inside");
+        assert_eq!(
+            found["inside"], joint["inside_mesh"],
+            "{model}: {name} inside"
+        );
         assert_eq!(found["parent"], joint["parent"], "{model}: {name} parent");
     }
 }
@@ -76,7 +85,12 @@ fn hand() {
 
 #[test]
 fn makehuman() {
-    check("makehuman", "base.obj", Some("default.mhskel"), Some("body"));
+    check(
+        "makehuman",
+        "base.obj",
+        Some("default.mhskel"),
+        Some("body"),
+    );
 }
 
 #[test]

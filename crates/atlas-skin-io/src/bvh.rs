@@ -271,9 +271,9 @@ fn bind_skeleton(path: &Path, joints: &[Joint]) -> Result<Skeleton, IoError> {
     }
     let names = joints.iter().map(|j| j.name.clone()).collect();
     let parents = joints.iter().map(|j| j.parent).collect();
-    Skeleton::from_positions(names, parents, &positions).map_err(|source| IoError::Skeleton {
+    Skeleton::from_positions(names, parents, &positions).map_err(|cause| IoError::Skeleton {
         path: path.to_path_buf(),
-        source,
+        cause,
     })
 }
 

@@ -4,17 +4,19 @@ use atlas_skin_runtime::RuntimeError;
 use std::path::PathBuf;
 use thiserror::Error;
 
+/// Causes are part of the message (fields named `cause`, not error sources), so a chain
+/// printer such as anyhow's `{:#}` shows each once.
 #[derive(Debug, Error)]
 pub enum IoError {
-    #[error("{}: cannot read: {source}", path.display())]
+    #[error("{}: cannot read: {cause}", path.display())]
     Read {
         path: PathBuf,
-        source: std::io::Error,
+        cause: std::io::Error,
     },
-    #[error("{}: cannot write: {source}", path.display())]
+    #[error("{}: cannot write: {cause}", path.display())]
     Write {
         path: PathBuf,
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     #[error("{}: is a directory, not a file", path.display())]
     IsDirectory { path: PathBuf },
@@ -36,11 +38,8 @@ pub enum IoError {
     /// A problem with the content of a file that is not tied to one line.
     #[error("{}: {message}", path.display())]
     Invalid { path: PathBuf, message: String },
-    #[error("{}: invalid skeleton: {source}", path.display())]
-    Skeleton {
-        path: PathBuf,
-        source: RuntimeError,
-    },
+    #[error("{}: invalid skeleton: {cause}", path.display())]
+    Skeleton { path: PathBuf, cause: RuntimeError },
     #[error("{}: refusing to write over the input file", path.display())]
     WouldOverwriteInput { path: PathBuf },
 }

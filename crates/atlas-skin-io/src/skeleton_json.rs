@@ -110,9 +110,9 @@ pub(crate) fn skeleton_from_parent_names(
             }),
         })
         .collect::<Result<Vec<u32>, IoError>>()?;
-    Skeleton::new(names, parents, inverse_bind).map_err(|source| IoError::Skeleton {
+    Skeleton::new(names, parents, inverse_bind).map_err(|cause| IoError::Skeleton {
         path: path.to_path_buf(),
-        source,
+        cause,
     })
 }
 

@@ -9,9 +9,9 @@ use std::str::FromStr;
 
 /// Errors for a path that is missing, unreadable, a directory or an empty file.
 pub(crate) fn check_file(path: &Path) -> Result<(), IoError> {
-    let metadata = std::fs::metadata(path).map_err(|source| IoError::Read {
+    let metadata = std::fs::metadata(path).map_err(|cause| IoError::Read {
         path: path.to_path_buf(),
-        source,
+        cause,
     })?;
     if metadata.is_dir() {
         return Err(IoError::IsDirectory {
@@ -29,9 +29,9 @@ pub(crate) fn check_file(path: &Path) -> Result<(), IoError> {
 /// The bytes of `path` (see [`check_file`]).
 pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, IoError> {
     check_file(path)?;
-    std::fs::read(path).map_err(|source| IoError::Read {
+    std::fs::read(path).map_err(|cause| IoError::Read {
         path: path.to_path_buf(),
-        source,
+        cause,
     })
 }
 

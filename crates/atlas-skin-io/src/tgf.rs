@@ -89,10 +89,10 @@ pub fn read(path: &Path) -> Result<TgfSkeleton, IoError> {
         parents[b as usize] = a;
     }
     let names = (1..=positions.len()).map(|k| format!("tgf_{k}")).collect();
-    let skeleton = Skeleton::from_positions(names, parents, &positions).map_err(|source| {
+    let skeleton = Skeleton::from_positions(names, parents, &positions).map_err(|cause| {
         IoError::Skeleton {
             path: path.to_path_buf(),
-            source,
+            cause,
         }
     })?;
     Ok(TgfSkeleton { skeleton, bones })

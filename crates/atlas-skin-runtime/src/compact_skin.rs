@@ -23,7 +23,7 @@ pub struct CompactSkin {
 }
 
 impl CompactSkin {
-    /// Keeps the `max_influences` largest weights of every vertex, rescales each row to
+    /// Keeps the `max_influences` (at least 1) largest weights of every vertex, rescales each row to
     /// sum to 1 ([`VertexWeights::pruned`]) and lays them out with K = the largest
     /// remaining row length.
     ///

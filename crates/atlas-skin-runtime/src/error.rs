@@ -28,10 +28,14 @@ pub enum RuntimeError {
     BadWeight { vertex: usize, weight: f32 },
     #[error("buffer sizes disagree: {what}")]
     BufferSize { what: String },
-    #[error("palette matrix {joint} has scale {scale} (or shear, or a projective row); dual quaternion skinning needs rigid transforms")]
+    #[error("palette matrix {joint} has scale {scale} (or shear); dual quaternion skinning needs rigid transforms")]
     NonRigid { joint: usize, scale: f32 },
     #[error("palette matrix {joint} is not finite")]
     NonFinitePalette { joint: usize },
+    #[error(
+        "palette matrix {joint} has bottom row {row:?}, not (0, 0, 0, 1): not an affine transform"
+    )]
+    ProjectivePalette { joint: usize, row: [f32; 4] },
     #[error("rig node {node} ({name:?}): {what}")]
     BadRig {
         node: usize,

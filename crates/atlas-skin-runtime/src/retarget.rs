@@ -128,6 +128,9 @@ impl Retarget {
     /// - `source`: the source rig; `source_local`: its #Ns local transforms (a sampled
     ///   clip frame).
     /// - `target`: the target rig; `out_target_local`: its #Nt local transforms.
+    ///
+    /// The rigs must be the ones given to [`Retarget::new`] (the mapping and rest data
+    /// were computed from them).
     pub fn apply(
         &mut self,
         source: &Rig,

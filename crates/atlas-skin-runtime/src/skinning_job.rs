@@ -127,22 +127,16 @@ impl SkinningJob<'_> {
     }
 }
 
-/// A blend of per-joint transforms into one per-vertex transform, and how that transform
-/// moves points and directions.
+/// A blend of per-joint transforms into one per-vertex matrix.
 trait Blend: Copy + Send + Sync {
-    type Transform;
     /// Blends the transforms of `joints` with weights `explicit` (#joints − 1 of them; the
     /// last is `1 − Σ explicit`).
-    fn blend(palette: &[Self], joints: &[u16], explicit: &[f32]) -> Self::Transform;
-    fn point(t: &Self::Transform, p: Vec3) -> Vec3;
-    fn vector(t: &Self::Transform, v: Vec3) -> Vec3;
+    fn blend(palette: &[Self], joints: &[u16], explicit: &[f32]) -> Mat4;
     /// A loop using this CPU's vector instructions, when there is one.
     fn simd_kernel(k: usize, normals: bool, tangents: bool) -> Option<Kernel<Self>>;
 }
 
 impl Blend for Mat4 {
-    type Transform = Mat4;
-
     /// `Σ_i ω_i M_i`. Accumulating the implicit last weight after the explicit ones makes
     /// an identity palette give a diagonal of exactly 1 (the sum `S + fl(1 − S)` rounds to
     /// 1 for every `S` in [0, 1]).
@@ -158,16 +152,6 @@ impl Blend for Mat4 {
         blended + palette[usize::from(joints[last])] * (1.0 - sum)
     }
 
-    #[inline(always)]
-    fn point(m: &Mat4, p: Vec3) -> Vec3 {
-        m.transform_point3(p)
-    }
-
-    #[inline(always)]
-    fn vector(m: &Mat4, v: Vec3) -> Vec3 {
-        m.transform_vector3(v)
-    }
-
     fn simd_kernel(k: usize, normals: bool, tangents: bool) -> Option<Kernel<Self>> {
         #[cfg(target_arch = "x86_64")]
         return crate::skinning_avx2::linear_blend_kernel(k, normals, tangents);
@@ -177,8 +161,6 @@ impl Blend for Mat4 {
 }
 
 impl Blend for DualQuat {
-    type Transform = Mat4;
-
     /// `b̂ / ‖b̂‖`, `b̂ = Σ_i s_i ω_i q̂_i`, `s_i = sign(real(q̂_i) · real(q̂_0))`, as the
     /// matrix of its rotation and translation: transforming a point and a normal by a
     /// matrix costs less than two quaternion rotations (Kavan et al. 2007 §4 do the same
@@ -205,16 +187,6 @@ impl Blend for DualQuat {
         }
         add(joints[last], 1.0 - sum);
         DualQuat { real, dual }.normalized_matrix()
-    }
-
-    #[inline(always)]
-    fn point(m: &Mat4, p: Vec3) -> Vec3 {
-        m.transform_point3(p)
-    }
-
-    #[inline(always)]
-    fn vector(m: &Mat4, v: Vec3) -> Vec3 {
-        m.transform_vector3(v)
     }
 
     fn simd_kernel(k: usize, normals: bool, tangents: bool) -> Option<Kernel<Self>> {
@@ -360,14 +332,14 @@ fn skin_span<B: Blend, const K: usize, const NORMALS: bool, const TANGENTS: bool
     let explicit_len = k - 1;
     for (v, joints) in joint_rows.enumerate() {
         let explicit = &span.weights[v * explicit_len..(v + 1) * explicit_len];
-        let transform = B::blend(palette, joints, explicit);
-        span.out_positions[v] = B::point(&transform, span.rest_positions[v]);
+        let m = B::blend(palette, joints, explicit);
+        span.out_positions[v] = m.transform_point3(span.rest_positions[v]);
         if NORMALS {
-            span.out_normals[v] = B::vector(&transform, span.rest_normals[v]);
+            span.out_normals[v] = m.transform_vector3(span.rest_normals[v]);
         }
         if TANGENTS {
             let t = span.rest_tangents[v];
-            span.out_tangents[v] = B::vector(&transform, t.truncate()).extend(t.w);
+            span.out_tangents[v] = m.transform_vector3(t.truncate()).extend(t.w);
         }
     }
 }

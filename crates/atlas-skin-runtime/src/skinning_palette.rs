@@ -47,7 +47,8 @@ impl SkinningPalette {
     /// [`RuntimeError::NonFinitePalette`], and for dual quaternions
     /// [`RuntimeError::NonRigid`] when a matrix's linear part is not a rotation within
     /// [`RIGID_TOLERANCE`] (scale is rejected, not approximated: a unit dual quaternion
-    /// cannot carry it). The projective row must be (0, 0, 0, 1) for both methods.
+    /// cannot carry it); [`RuntimeError::ProjectivePalette`] when a bottom row is not
+    /// (0, 0, 0, 1), for both methods.
     pub fn update(&mut self, palette: &[Mat4], method: SkinningMethod) -> Result<(), RuntimeError> {
         if palette.len() != self.matrices.len() {
             return Err(RuntimeError::BufferSize {
@@ -63,9 +64,9 @@ impl SkinningPalette {
                 return Err(RuntimeError::NonFinitePalette { joint });
             }
             if m.row(3) != glam::Vec4::W {
-                return Err(RuntimeError::NonRigid {
+                return Err(RuntimeError::ProjectivePalette {
                     joint,
-                    scale: m.row(3).w,
+                    row: m.row(3).to_array(),
                 });
             }
         }

@@ -44,61 +44,70 @@ pub struct CutCandidate {
     pub perimeter: f64,
 }
 
-/// Every closed section around the joint of `frame` found by the search, best (shortest)
-/// first; empty when no sampled plane gives a closed curve around the joint.
+/// The surface the cut search runs on, with what is built once for all joints.
+#[derive(Debug, Clone, Copy)]
+pub struct CutSurface<'a> {
+    pub mesh: &'a SurfaceMesh,
+    pub topology: &'a Topology,
+    pub spheres: &'a FaceSpheres,
+    /// #V snap distances ([`crate::plane_section::vertex_snap_distances`]).
+    pub vertex_snap: &'a [f64],
+    pub params: &'a DecomposeParams,
+}
+
+/// What the search found at one joint.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct CutSearch {
+    /// Every acceptable closed section, best (shortest) first.
+    pub candidates: Vec<CutCandidate>,
+    /// Closed sections around the joint turned down because another bone passes through
+    /// them (in the last neighbourhood tried).
+    pub enclosing_other_bones: usize,
+}
+
+/// Every closed section around the joint of `frame` that no bone of `other_bones` passes
+/// through, found by the search; none when no sampled plane gives one.
 pub fn find_cut_candidates(
-    mesh: &SurfaceMesh,
-    topology: &Topology,
-    spheres: &FaceSpheres,
-    vertex_snap: &[f64],
+    surface: &CutSurface,
     frame: &JointFrame,
     other_bones: &[[DVec3; 2]],
-    params: &DecomposeParams,
-) -> Vec<CutCandidate> {
+) -> CutSearch {
     let mut radius =
-        params.neighbourhood_factor * frame.surface_distance.max(0.1 * frame.bone_length);
+        surface.params.neighbourhood_factor * frame.surface_distance.max(0.1 * frame.bone_length);
+    let mut last = CutSearch::default();
     for _ in 0..NEIGHBOURHOOD_ATTEMPTS {
-        let faces = spheres.faces_near(frame.position, radius);
-        let everything = faces.len() == mesh.triangle_count();
+        let faces = surface.spheres.faces_near(frame.position, radius);
+        let everything = faces.len() == surface.mesh.triangle_count();
         let near_bones: Vec<[DVec3; 2]> = other_bones
             .iter()
             .filter(|[a, b]| segment_distance(frame.position, *a, *b) <= 2.0 * radius)
             .copied()
             .collect();
-        let candidates = search_within(
-            mesh,
-            topology,
-            vertex_snap,
-            frame,
-            &near_bones,
-            params,
-            faces,
-        );
-        if !candidates.is_empty() || everything {
-            return candidates;
+        let search = search_within(surface, frame, &near_bones, faces);
+        if !search.candidates.is_empty() || everything {
+            return search;
         }
+        last = search;
         radius *= 2.0;
     }
-    Vec::new()
+    last
 }
 
 /// The search of [`find_cut_candidates`] on the sections within `faces`.
 fn search_within(
-    mesh: &SurfaceMesh,
-    topology: &Topology,
-    vertex_snap: &[f64],
+    surface: &CutSurface,
     frame: &JointFrame,
     other_bones: &[[DVec3; 2]],
-    params: &DecomposeParams,
     faces: Vec<u32>,
-) -> Vec<CutCandidate> {
+) -> CutSearch {
+    let (mesh, topology, params) = (surface.mesh, surface.topology, surface.params);
     let mut search = PlaneSearch {
         mesh,
         topology,
-        vertex_snap,
         other_bones,
+        enclosing_other_bones: 0,
         position: frame.position,
-        domain: SectionDomain::new(mesh, topology, faces),
+        domain: SectionDomain::new(mesh, topology, surface.vertex_snap, faces),
         basis: NormalBasis::new(frame.upper, frame.lower),
     };
     let step = params.angle_step_deg.to_radians();
@@ -137,11 +146,14 @@ fn search_within(
     }
     let mut candidates: Vec<CutCandidate> = found.into_iter().map(|(_, _, c)| c).collect();
     candidates.sort_by(|x, y| x.perimeter.total_cmp(&y.perimeter));
-    candidates
+    CutSearch {
+        candidates,
+        enclosing_other_bones: search.enclosing_other_bones,
+    }
 }
 
-/// The frame the normals are parametrised in: n(α, β) ∝ cos α cos β · a + sin α cos β · b
-/// + sin β · c, with a the bisector of the bones. In the planar case β = 0 and b spans Q
+/// The frame the normals are parametrised in:
+/// n(α, β) ∝ cos α cos β · a + sin α cos β · b + sin β · c, with a the bisector of the bones. In the planar case β = 0 and b spans Q
 /// with a; in the cone case b, c are any unit pair orthogonal to a.
 #[derive(Debug, Clone, Copy)]
 struct NormalBasis {
@@ -235,9 +247,10 @@ impl NormalBasis {
 struct PlaneSearch<'a> {
     mesh: &'a SurfaceMesh,
     topology: &'a Topology,
-    vertex_snap: &'a [f64],
     /// Bones not incident to J near it, as segments.
     other_bones: &'a [[DVec3; 2]],
+    /// Count of sections around J turned down for enclosing another bone.
+    enclosing_other_bones: usize,
     position: DVec3,
     domain: SectionDomain,
     basis: NormalBasis,
@@ -251,34 +264,32 @@ impl PlaneSearch<'_> {
             point: self.position,
             normal: self.basis.normal(alpha, beta),
         };
-        self.domain
-            .closed_sections(self.mesh, self.topology, self.vertex_snap, &plane)
-            .into_iter()
-            .filter_map(|curve| {
-                let points = curve.positions(self.mesh, self.topology);
-                let around_joint = polygon_contains(&points, plane.normal, plane.point);
-                let cuts_other_bone = || {
-                    self.other_bones.iter().any(|&[a, b]| {
-                        let (da, db) = (plane.signed_distance(a), plane.signed_distance(b));
-                        (da < 0.0) != (db < 0.0)
-                            && polygon_contains(
-                                &points,
-                                plane.normal,
-                                a + (b - a) * (da / (da - db)),
-                            )
-                    })
-                };
-                (around_joint && !cuts_other_bone()).then(|| {
-                    let perimeter = closed_length(&points);
-                    CutCandidate {
-                        plane,
-                        curve,
-                        points,
-                        perimeter,
-                    }
-                })
-            })
-            .min_by(|x, y| x.perimeter.total_cmp(&y.perimeter))
+        let mut best: Option<CutCandidate> = None;
+        for curve in self.domain.closed_sections(self.topology, &plane) {
+            let points = curve.positions(self.mesh, self.topology);
+            if !polygon_contains(&points, plane.normal, plane.point) {
+                continue;
+            }
+            let encloses_other_bone = self.other_bones.iter().any(|&[a, b]| {
+                let (da, db) = (plane.signed_distance(a), plane.signed_distance(b));
+                (da < 0.0) != (db < 0.0)
+                    && polygon_contains(&points, plane.normal, a + (b - a) * (da / (da - db)))
+            });
+            if encloses_other_bone {
+                self.enclosing_other_bones += 1;
+                continue;
+            }
+            let perimeter = closed_length(&points);
+            if best.as_ref().is_none_or(|b| perimeter < b.perimeter) {
+                best = Some(CutCandidate {
+                    plane,
+                    curve,
+                    points,
+                    perimeter,
+                });
+            }
+        }
+        best
     }
 }
 

@@ -16,7 +16,7 @@
 //! [`crate::joint_roles`], or when no region holds it (an empty surface); the report says
 //! which.
 
-use crate::cut::{find_cut_candidates, CutCandidate};
+use crate::cut::{find_cut_candidates, CutCandidate, CutSearch, CutSurface};
 use crate::joint_roles::{plan_joints, JointFrame, JointPlan, Override};
 use crate::plane_section::{diameter, vertex_snap_distances, Chord, CrossingPoint, SectionCurve};
 use crate::proximity::FaceSpheres;
@@ -54,7 +54,8 @@ pub struct DecomposeParams {
     /// A joint outside the surface and farther from it than this many times its longest
     /// bone owns no geometry.
     pub outside_ratio: f64,
-    /// Mirror-plane fit and on-plane tolerance, relative to the skeleton's diagonal.
+    /// Mirror-plane fit tolerance, relative to the skeleton's diagonal (a joint is on the
+    /// plane within a quarter of it).
     pub symmetry_tolerance: f64,
     /// Joints (by name) that get a boundary whatever their role.
     pub force: Vec<String>,
@@ -65,7 +66,7 @@ pub struct DecomposeParams {
 impl Default for DecomposeParams {
     fn default() -> Self {
         Self {
-            angle_step_deg: 5.0,
+            angle_step_deg: 10.0,
             cone_half_angle_deg: 30.0,
             refine_iterations: 8,
             neighbourhood_factor: 4.0,
@@ -124,40 +125,21 @@ pub fn decompose(
         .collect();
     let spheres = FaceSpheres::new(mesh);
     let vertex_snap = vertex_snap_distances(mesh, topology, params.snap_fraction);
-    let (_, plans) = plan_joints(mesh, &spheres, skeleton, &positions, &overrides, params);
-    let bones: Vec<(usize, usize)> = (0..skeleton.len())
-        .filter_map(|j| skeleton.parent(j).map(|p| (p, j)))
-        .filter(|&(p, j)| positions[p] != positions[j])
-        .collect();
-    let candidates: Vec<Vec<CutCandidate>> = plans
-        .par_iter()
-        .enumerate()
-        .map(|(j, plan)| match plan {
-            JointPlan::Boundary(frame) => {
-                let other_bones: Vec<[DVec3; 2]> = bones
-                    .iter()
-                    .filter(|&&(p, c)| p != j && c != j)
-                    .map(|&(p, c)| [positions[p], positions[c]])
-                    .collect();
-                find_cut_candidates(
-                    mesh,
-                    topology,
-                    &spheres,
-                    &vertex_snap,
-                    frame,
-                    &other_bones,
-                    params,
-                )
-            }
-            JointPlan::Skip(_) => Vec::new(),
-        })
-        .collect();
+    let plans = plan_joints(mesh, &spheres, skeleton, &positions, &overrides, params);
+    let cut_surface = CutSurface {
+        mesh,
+        topology,
+        spheres: &spheres,
+        vertex_snap: &vertex_snap,
+        params,
+    };
+    let searches = search_all_cuts(&cut_surface, skeleton, &positions, &plans);
     let placements = place_cuts(
         mesh,
         topology,
         skeleton,
         &plans,
-        &candidates,
+        &searches,
         params.snap_fraction,
     );
 
@@ -165,7 +147,7 @@ pub fn decompose(
         .iter()
         .enumerate()
         .filter_map(|(j, p)| match p {
-            Placement::Cut { candidate, .. } => Some(&candidates[j][*candidate].curve),
+            Placement::Cut { candidate, .. } => Some(&searches[j].candidates[*candidate].curve),
             _ => None,
         })
         .collect();
@@ -182,9 +164,10 @@ pub fn decompose(
         .map(|(j, placement)| match placement {
             Placement::Cut { candidate, frame } => {
                 let curve = loops.next().unwrap_or_default();
-                let plane = &candidates[j][candidate].plane;
+                let plane = &searches[j].candidates[candidate].plane;
                 match side_regions(&surface, &split_topology, &face_region, &curve, plane) {
                     Some((parent, child)) if parent != child => Outcome::Cut {
+                        candidate,
                         curve,
                         parent,
                         child,
@@ -221,6 +204,27 @@ pub fn decompose(
         &sides(false),
     );
 
+    let (boundaries, joints) = decide_joints(skeleton, outcomes, &joint_region, &searches);
+    Ok(Decomposition {
+        topology: split_topology,
+        welded_vertex_count: mesh.vertex_count(),
+        surface,
+        face_region,
+        regions,
+        boundaries,
+        joints,
+    })
+}
+
+/// The boundaries and the per-joint decisions, in skeleton order. A cut's plane,
+/// perimeter and diameter are those of its placed section; a soft boundary's those of the
+/// joint's best section (see [`boundary_geometry`]).
+fn decide_joints(
+    skeleton: &Skeleton,
+    outcomes: Vec<Outcome>,
+    joint_region: &[Option<u32>],
+    searches: &[CutSearch],
+) -> (Vec<Boundary>, Vec<JointDecision>) {
     let mut boundaries = Vec::new();
     let joints = outcomes
         .into_iter()
@@ -228,8 +232,15 @@ pub fn decompose(
         .map(|(j, outcome)| {
             let name = skeleton.names[j].clone();
             let region = joint_region[j];
-            let (status, kind, frame, parent_region, child_region) = match outcome {
+            let skipped = |name: String, reason: String| JointDecision {
+                name,
+                status: JointStatus::Skipped(reason),
+                boundary: None,
+                region,
+            };
+            let (status, kind, frame, section, parent_region, child_region) = match outcome {
                 Outcome::Cut {
+                    candidate,
                     curve,
                     parent,
                     child,
@@ -238,34 +249,32 @@ pub fn decompose(
                     JointStatus::Cut,
                     BoundaryKind::Cut { curve },
                     frame,
+                    searches[j].candidates.get(candidate),
                     parent,
                     child,
                 ),
                 Outcome::Soft { reason, frame } => match region {
-                    Some(r) => (JointStatus::Soft(reason), BoundaryKind::Soft, frame, r, r),
+                    Some(r) => (
+                        JointStatus::Soft(reason),
+                        BoundaryKind::Soft,
+                        frame,
+                        searches[j].candidates.first(),
+                        r,
+                        r,
+                    ),
                     None => {
-                        let reason = format!("{reason}; no surface region holds the joint");
-                        return JointDecision {
+                        return skipped(
                             name,
-                            status: JointStatus::Skipped(reason),
-                            boundary: None,
-                            region,
-                        };
+                            format!("{reason}; no surface region holds the joint"),
+                        )
                     }
                 },
-                Outcome::Skip(reason) => {
-                    return JointDecision {
-                        name,
-                        status: JointStatus::Skipped(reason),
-                        boundary: None,
-                        region,
-                    }
-                }
+                Outcome::Skip(reason) => return skipped(name, reason),
             };
             boundaries.push(boundary_geometry(
                 j,
                 &frame,
-                candidates[j].first(),
+                section,
                 kind,
                 parent_region,
                 child_region,
@@ -278,16 +287,36 @@ pub fn decompose(
             }
         })
         .collect();
+    (boundaries, joints)
+}
 
-    Ok(Decomposition {
-        topology: split_topology,
-        welded_vertex_count: mesh.vertex_count(),
-        surface,
-        face_region,
-        regions,
-        boundaries,
-        joints,
-    })
+/// The cut search of every joint that gets a boundary (in parallel over joints); the
+/// other bones a section must not enclose are all bones not at the joint.
+fn search_all_cuts(
+    surface: &CutSurface,
+    skeleton: &Skeleton,
+    positions: &[DVec3],
+    plans: &[JointPlan],
+) -> Vec<CutSearch> {
+    let bones: Vec<(usize, usize)> = (0..skeleton.len())
+        .filter_map(|j| skeleton.parent(j).map(|p| (p, j)))
+        .filter(|&(p, j)| positions[p] != positions[j])
+        .collect();
+    plans
+        .par_iter()
+        .enumerate()
+        .map(|(j, plan)| match plan {
+            JointPlan::Boundary(frame) => {
+                let other_bones: Vec<[DVec3; 2]> = bones
+                    .iter()
+                    .filter(|&&(p, c)| p != j && c != j)
+                    .map(|&(p, c)| [positions[p], positions[c]])
+                    .collect();
+                find_cut_candidates(surface, frame, &other_bones)
+            }
+            JointPlan::Skip(_) => CutSearch::default(),
+        })
+        .collect()
 }
 
 /// Where the conflict rule put a joint's boundary.
@@ -309,6 +338,8 @@ enum Placement {
 #[derive(Debug, Clone, PartialEq)]
 enum Outcome {
     Cut {
+        /// Index of the placed candidate.
+        candidate: usize,
         curve: Vec<u32>,
         parent: u32,
         child: u32,
@@ -327,9 +358,10 @@ fn place_cuts(
     topology: &Topology,
     skeleton: &Skeleton,
     plans: &[JointPlan],
-    candidates: &[Vec<CutCandidate>],
+    searches: &[CutSearch],
     gap: f64,
 ) -> Vec<Placement> {
+    let candidates: Vec<&[CutCandidate]> = searches.iter().map(|s| &s.candidates[..]).collect();
     let mut order: Vec<usize> = (0..plans.len())
         .filter(|&j| !candidates[j].is_empty())
         .collect();
@@ -376,7 +408,8 @@ fn place_cuts(
     plans
         .iter()
         .zip(placed)
-        .map(|(plan, placed)| {
+        .zip(searches)
+        .map(|((plan, placed), search)| {
             let frame = match plan {
                 JointPlan::Skip(reason) => return Placement::Skip(reason.clone()),
                 JointPlan::Boundary(frame) => *frame,
@@ -395,6 +428,11 @@ fn place_cuts(
                         names.join(", ")
                     )
                 }
+                None if search.enclosing_other_bones > 0 => format!(
+                    "each of the {} closed sections around the joint also encloses another bone \
+                     (a plane across a palm, a foot or the torso)",
+                    search.enclosing_other_bones
+                ),
                 None => "no closed cross-section around the joint near it (open surface, \
                          joint outside, or a section reaching far from the joint)"
                     .into(),
@@ -419,18 +457,19 @@ fn curve_vertices(curve: &SectionCurve) -> Vec<u32> {
     vertices
 }
 
-/// Plane, perimeter and diameter of a boundary. A soft boundary takes the best closed
-/// section when there is one; otherwise its normal is the bisector of the bones and its
-/// section a circle of the joint's surface distance r (perimeter 2πr, diameter 2r).
+/// Plane, perimeter and diameter of a boundary from `section`: the placed section of a cut,
+/// the best closed section of a soft boundary. Without one the normal is the bisector of
+/// the bones and the section a circle of the joint's surface distance r (perimeter 2πr,
+/// diameter 2r).
 fn boundary_geometry(
     joint: usize,
     frame: &JointFrame,
-    best: Option<&CutCandidate>,
+    section: Option<&CutCandidate>,
     kind: BoundaryKind,
     parent_region: u32,
     child_region: u32,
 ) -> Boundary {
-    let (normal, perimeter, diameter) = match best {
+    let (normal, perimeter, diameter) = match section {
         Some(c) => (c.plane.normal, c.perimeter, diameter(&c.points)),
         None => {
             let r = frame.surface_distance;

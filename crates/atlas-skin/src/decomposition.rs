@@ -1,5 +1,5 @@
 //! The result of the decomposition stages (§3.1 cuts, §3.2 regions): what the weights stage
-//! (§3.3–§5) reads. Plain data; [`crate::decompose`] builds it.
+//! (§3.3–§5) reads. Plain data; [`crate::decompose()`] builds it.
 
 use crate::{SurfaceMesh, Topology};
 use glam::DVec3;

@@ -2,22 +2,23 @@
 //!
 //! The rules, in the order they are applied to joint J at bind position p_J:
 //! 1. Forbidden by the user: no boundary. Forced by the user: a boundary, whatever follows.
-//! 2. A root has no upper bone to cut: its region is the root region.
+//! 2. A root has no upper bone to cut: its region is the root region. A joint whose bones
+//!    all have zero length has no direction to cut across: no boundary.
 //! 3. A branching joint (two or more children) on the skeleton's mirror plane (pelvis,
 //!    chest) has no boundary, as in the paper. Off the plane (a clavicle with a breast bone,
 //!    a wrist with five finger bones) it is cut like a chain joint whose lower bone is the
 //!    mean of its unit child directions — for a wrist, the average finger direction.
-//! 4. A leaf owns geometry when its parent's bone runs on into the mesh: the ray from p_J
-//!    along the upper bone leaves the surface from inside (hit face normal along the ray on
-//!    an outward-oriented surface) at a distance ≥ `leaf_extent_ratio` × the joint's
-//!    surface distance. It is then cut with lower bone = upper bone. Otherwise it is an end
-//!    site: no boundary.
-//! 5. A joint lies outside the mesh and owns no geometry when it is farther from the
+//! 4. A joint lies outside the mesh and owns no geometry when it is farther from the
 //!    surface than `outside_ratio` × its longest bone and outside it: most of six rays from
 //!    it (±x, ±y, ±z, slightly turned) first meet the surface from outside, or not at all.
 //!    Then: no boundary. A joint near the surface (a face bone in an eye socket) keeps its
 //!    boundary: the skin around it is its to move. A winding number is not used: it fails
 //!    on open and multi-piece meshes; the ray vote needs only a locally outward surface.
+//! 5. A leaf owns geometry when its parent's bone runs on into the mesh: the ray from p_J
+//!    along the upper bone leaves the surface from inside (hit face normal along the ray on
+//!    an outward-oriented surface) at a distance ≥ `leaf_extent_ratio` × the joint's
+//!    surface distance. It is then cut with lower bone = upper bone. Otherwise it is an end
+//!    site: no boundary.
 //! 6. Twist and helper joints on a straight bone are chain joints with collinear bones: they
 //!    are cut perpendicular to the bone (the cone search), and the weights stage blends the
 //!    regions of one limb; nothing tells them apart from a straight elbow geometrically.
@@ -27,6 +28,7 @@
 //! bone length, that maps the joint set best onto itself.
 
 use crate::decompose::DecomposeParams;
+use crate::nearest_bone::point_segment_distance;
 use crate::proximity::FaceSpheres;
 use crate::SurfaceMesh;
 use atlas_skin_runtime::Skeleton;
@@ -74,6 +76,20 @@ pub enum Override {
     Forbid,
 }
 
+/// A joint is on the mirror plane within this fraction of the fit tolerance: a pelvis or
+/// chest sits on it to rounding, while the branching joints of an eye or a cheek lie a
+/// few percent of the skeleton's size off it.
+const ON_PLANE: f64 = 0.25;
+
+/// Rule 5's second test: the part of the surface nearest to a leaf owns geometry when it
+/// reaches this many times the joint's surface distance past it (a toe beyond the ball of a
+/// foot reaches 2–7 times; a fingertip cap around an end site about 1.4–1.7 times).
+const LEAF_REACH_RATIO: f64 = 2.0;
+
+/// A joint nearer to the surface than this fraction of its bone lies in the skin (a face
+/// bone): the part nearest to it is a patch of skin, not a part of the body past it.
+const INTERIOR_RADIUS: f64 = 0.1;
+
 /// Bones shorter than this fraction of the skeleton's diagonal have no direction.
 const ZERO_BONE: f64 = 1e-9;
 
@@ -86,12 +102,12 @@ pub fn plan_joints(
     positions: &[DVec3],
     overrides: &[Option<Override>],
     params: &DecomposeParams,
-) -> (Option<SymmetryPlane>, Vec<JointPlan>) {
+) -> Vec<JointPlan> {
     let children = skeleton.children();
     let scale = diagonal(positions).max(f64::MIN_POSITIVE);
     let symmetry = infer_symmetry_plane(skeleton, positions, params.symmetry_tolerance);
     let orientation = orientation_sign(mesh);
-    let plans = (0..skeleton.len())
+    (0..skeleton.len())
         .into_par_iter()
         .map(|j| {
             let forced = overrides[j] == Some(Override::Force);
@@ -140,7 +156,7 @@ pub fn plan_joints(
             if children[j].len() >= 2 {
                 if let Some(plane) = &symmetry {
                     let off = (plane.normal.dot(p) - plane.offset).abs();
-                    if off <= params.symmetry_tolerance * scale {
+                    if off <= ON_PLANE * params.symmetry_tolerance * scale {
                         return JointPlan::Skip(format!(
                             "branching joint on the mirror plane ({} children)",
                             children[j].len()
@@ -156,27 +172,78 @@ pub fn plan_joints(
                      away, longest bone {longest_bone:.4}"
                 ));
             }
-            if children[j].is_empty() {
-                let extent = spheres
-                    .first_hit(mesh, p, upper)
-                    .filter(|hit| {
-                        let n = mesh.scaled_normal(hit.face as usize);
-                        orientation * n.dot(upper) >= 0.0
-                    })
-                    .map(|hit| hit.distance);
-                match extent {
-                    Some(t) if t >= params.leaf_extent_ratio * surface_distance => {}
-                    _ => {
-                        return JointPlan::Skip(
-                            "end site: the bone does not run on into the mesh".into(),
-                        )
-                    }
-                }
+            if children[j].is_empty() && !leaf_owns_geometry(mesh, spheres, skeleton, positions, j, &frame, orientation, params) {
+                return JointPlan::Skip(
+                    "end site: the surface does not run on past the joint".into(),
+                );
             }
             JointPlan::Boundary(frame)
         })
+        .collect()
+}
+
+/// Rule 5: whether leaf `j` owns geometry (see the module doc).
+#[allow(clippy::too_many_arguments)]
+fn leaf_owns_geometry(
+    mesh: &SurfaceMesh,
+    spheres: &FaceSpheres,
+    skeleton: &Skeleton,
+    positions: &[DVec3],
+    j: usize,
+    frame: &JointFrame,
+    orientation: f64,
+    params: &DecomposeParams,
+) -> bool {
+    let (p, upper, radius) = (frame.position, frame.upper, frame.surface_distance);
+    let threshold = params.leaf_extent_ratio * radius;
+    let exit_along_bone = spheres.first_hit(mesh, p, upper).filter(|hit| {
+        orientation * mesh.scaled_normal(hit.face as usize).dot(upper) >= 0.0
+    });
+    if exit_along_bone.is_some_and(|hit| hit.distance >= threshold) {
+        return true;
+    }
+    if radius < INTERIOR_RADIUS * frame.bone_length {
+        return false;
+    }
+    let other_bones: Vec<[DVec3; 2]> = (0..skeleton.len())
+        .filter_map(|c| skeleton.parent(c).map(|q| (q, c)))
+        .filter(|&(q, c)| q != j && c != j)
+        .map(|(q, c)| [positions[q], positions[c]])
         .collect();
-    (symmetry, plans)
+    let reach_threshold = LEAF_REACH_RATIO * radius;
+    leaf_reach(mesh, spheres, p, upper, &other_bones, 1.01 * reach_threshold) >= reach_threshold
+}
+
+/// The largest distance from `p` of the surface vertices within `radius` of it that lie
+/// past it along `direction` ((v − p) · direction > 0) and nearer to `p` than to each bone
+/// of `other_bones`: how far the part beyond a leaf joint reaches.
+fn leaf_reach(
+    mesh: &SurfaceMesh,
+    spheres: &FaceSpheres,
+    p: DVec3,
+    direction: DVec3,
+    other_bones: &[[DVec3; 2]],
+    radius: f64,
+) -> f64 {
+    let mut vertices: Vec<u32> = spheres
+        .faces_near(p, radius)
+        .into_iter()
+        .flat_map(|f| mesh.triangles[f as usize])
+        .collect();
+    vertices.sort_unstable();
+    vertices.dedup();
+    vertices
+        .into_iter()
+        .map(|v| mesh.positions[v as usize])
+        .filter(|&v| (v - p).dot(direction) > 0.0 && v.distance(p) <= radius)
+        .filter(|&v| {
+            let d = v.distance(p);
+            other_bones
+                .iter()
+                .all(|&[a, b]| point_segment_distance(v, a, b) > d)
+        })
+        .map(|v| v.distance(p))
+        .fold(0.0, f64::max)
 }
 
 /// Whether at least four of six rays from `p` first meet the surface leaving it (the hit

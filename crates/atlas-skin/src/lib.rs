@@ -29,7 +29,9 @@ pub mod weld;
 pub mod winding;
 
 pub use decompose::{decompose, DecomposeError, DecomposeParams};
-pub use decomposition::{Boundary, BoundaryKind, Decomposition, JointDecision, JointStatus, Region};
+pub use decomposition::{
+    Boundary, BoundaryKind, Decomposition, JointDecision, JointStatus, Region,
+};
 pub use mesh::SurfaceMesh;
 pub use topology::{MeshStats, Topology};
 pub use weld::{weld, Welded};

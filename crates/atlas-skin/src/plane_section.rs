@@ -80,7 +80,13 @@ pub struct Chord {
 #[derive(Debug, Clone)]
 pub struct SectionDomain {
     faces: Vec<u32>,
+    /// The domain's faces as triples of local vertex indices.
+    local_faces: Vec<[u32; 3]>,
+    /// Per local vertex: its global index, position, snap distance and signed distance.
     vertices: Vec<u32>,
+    local_positions: Vec<DVec3>,
+    local_snap: Vec<f64>,
+    local_distance: Vec<f64>,
     in_domain: Vec<bool>,
     distance: Vec<f64>,
     edge_stamp: Vec<u32>,
@@ -103,7 +109,12 @@ pub fn vertex_snap_distances(mesh: &SurfaceMesh, topology: &Topology, fraction: 
 impl SectionDomain {
     /// A domain of `faces` of `mesh`; faces with a repeated vertex index are left out (a
     /// curve reaching them is open).
-    pub fn new(mesh: &SurfaceMesh, topology: &Topology, faces: Vec<u32>) -> Self {
+    pub fn new(
+        mesh: &SurfaceMesh,
+        topology: &Topology,
+        vertex_snap: &[f64],
+        faces: Vec<u32>,
+    ) -> Self {
         let faces: Vec<u32> = faces
             .into_iter()
             .filter(|&f| {
@@ -112,18 +123,30 @@ impl SectionDomain {
             })
             .collect();
         let mut in_domain = vec![false; mesh.triangle_count()];
-        let mut seen = vec![false; mesh.vertex_count()];
+        let mut local_of = vec![u32::MAX; mesh.vertex_count()];
         let mut vertices = Vec::new();
-        for &f in &faces {
-            in_domain[f as usize] = true;
-            for v in mesh.triangles[f as usize] {
-                if !std::mem::replace(&mut seen[v as usize], true) {
-                    vertices.push(v);
-                }
-            }
-        }
+        let local_faces = faces
+            .iter()
+            .map(|&f| {
+                in_domain[f as usize] = true;
+                mesh.triangles[f as usize].map(|v| {
+                    if local_of[v as usize] == u32::MAX {
+                        local_of[v as usize] = vertices.len() as u32;
+                        vertices.push(v);
+                    }
+                    local_of[v as usize]
+                })
+            })
+            .collect();
         Self {
             faces,
+            local_faces,
+            local_positions: vertices
+                .iter()
+                .map(|&v| mesh.positions[v as usize])
+                .collect(),
+            local_snap: vertices.iter().map(|&v| vertex_snap[v as usize]).collect(),
+            local_distance: vec![0.0; vertices.len()],
             vertices,
             in_domain,
             distance: vec![0.0; mesh.vertex_count()],
@@ -132,28 +155,20 @@ impl SectionDomain {
         }
     }
 
-    /// Number of faces in the domain.
-    pub fn face_count(&self) -> usize {
-        self.faces.len()
-    }
-
     /// The closed curves in which `plane` meets the domain's faces. A chain that leaves the
     /// domain (a face outside it, a boundary or non-manifold edge) is open and dropped.
     /// Cost O(faces of the domain).
-    pub fn closed_sections(
-        &mut self,
-        mesh: &SurfaceMesh,
-        topology: &Topology,
-        vertex_snap: &[f64],
-        plane: &Plane,
-    ) -> Vec<SectionCurve> {
-        for &v in &self.vertices {
-            let d = plane.signed_distance(mesh.positions[v as usize]);
-            self.distance[v as usize] = if d.abs() < vertex_snap[v as usize] {
-                0.0
-            } else {
-                d
-            };
+    pub fn closed_sections(&mut self, topology: &Topology, plane: &Plane) -> Vec<SectionCurve> {
+        for (k, (p, snap)) in self
+            .local_positions
+            .iter()
+            .zip(&self.local_snap)
+            .enumerate()
+        {
+            let d = plane.signed_distance(*p);
+            let d = if d.abs() < *snap { 0.0 } else { d };
+            self.local_distance[k] = d;
+            self.distance[self.vertices[k] as usize] = d;
         }
         self.stamp = self.stamp.wrapping_add(1);
         if self.stamp == 0 {
@@ -162,11 +177,11 @@ impl SectionDomain {
         }
         let mut curves = Vec::new();
         for i in 0..self.faces.len() {
-            let f = self.faces[i] as usize;
-            let [a, b, c] = mesh.triangles[f].map(|v| self.positive(v));
+            let [a, b, c] = self.local_faces[i].map(|v| self.local_distance[v as usize] >= 0.0);
             if a == b && b == c {
                 continue;
             }
+            let f = self.faces[i] as usize;
             for &e in &topology.face_edges[f] {
                 if self.edge_stamp[e as usize] != self.stamp && self.is_crossed(topology, e) {
                     if let Some(curve) = self.trace(topology, e) {
@@ -367,12 +382,12 @@ mod tests {
         let mesh = icosphere(1.0, 4);
         let topology = Topology::new(&mesh);
         let snap = vertex_snap_distances(&mesh, &topology, 0.01);
-        let mut domain = SectionDomain::new(&mesh, &topology, all_faces(&mesh));
+        let mut domain = SectionDomain::new(&mesh, &topology, &snap, all_faces(&mesh));
         let plane = Plane {
             point: DVec3::new(0.0, 0.0, 0.3),
             normal: DVec3::Z,
         };
-        let curves = domain.closed_sections(&mesh, &topology, &snap, &plane);
+        let curves = domain.closed_sections(&topology, &plane);
         assert_eq!(curves.len(), 1);
         let points = curves[0].positions(&mesh, &topology);
         let radius = (1.0f64 - 0.09).sqrt();
@@ -395,12 +410,12 @@ mod tests {
         let mesh = uv_sphere(1.0, 8, 16);
         let topology = Topology::new(&mesh);
         let snap = vertex_snap_distances(&mesh, &topology, 0.01);
-        let mut domain = SectionDomain::new(&mesh, &topology, all_faces(&mesh));
+        let mut domain = SectionDomain::new(&mesh, &topology, &snap, all_faces(&mesh));
         let plane = Plane {
             point: DVec3::ZERO,
             normal: DVec3::Z,
         };
-        let curves = domain.closed_sections(&mesh, &topology, &snap, &plane);
+        let curves = domain.closed_sections(&topology, &plane);
         assert_eq!(curves.len(), 1);
         let mut vertices: Vec<u32> = curves[0]
             .crossings
@@ -423,23 +438,34 @@ mod tests {
             .into_iter()
             .filter(|&f| mesh.corners(f as usize).iter().all(|c| c.y > -0.2))
             .collect();
-        let mut domain = SectionDomain::new(&mesh, &topology, upper);
+        let mut domain = SectionDomain::new(&mesh, &topology, &snap, upper);
         let plane = Plane {
             point: DVec3::ZERO,
             normal: DVec3::Z,
         };
-        assert!(domain
-            .closed_sections(&mesh, &topology, &snap, &plane)
-            .is_empty());
+        assert!(domain.closed_sections(&topology, &plane).is_empty());
         let horizontal = Plane {
             point: DVec3::Y * 0.5,
             normal: DVec3::Y,
         };
-        assert_eq!(
-            domain
-                .closed_sections(&mesh, &topology, &snap, &horizontal)
-                .len(),
-            1
-        );
+        assert_eq!(domain.closed_sections(&topology, &horizontal).len(), 1);
+    }
+
+    #[test]
+    fn chords_cross_when_their_ends_interleave() {
+        let chord = |a: f64, b: f64| Chord {
+            face: 0,
+            ends: [a, b],
+        };
+        let gap = 0.01;
+        // Parallel chords cutting corner 1 off at two depths: no conflict.
+        assert!(!chord(0.5, 1.5).crosses_or_touches(&chord(0.8, 1.2), gap));
+        // Interleaved ends cross.
+        assert!(chord(0.5, 1.5).crosses_or_touches(&chord(1.2, 2.5), gap));
+        // A shared corner (s = 1) or ends closer than the gap touch.
+        assert!(chord(1.0, 2.5).crosses_or_touches(&chord(1.0, 0.5), gap));
+        assert!(chord(0.5, 1.5).crosses_or_touches(&chord(1.505, 2.5), gap));
+        // Ends on either side of s = 0 are close across the wrap.
+        assert!(chord(0.002, 1.5).crosses_or_touches(&chord(2.999, 1.8), gap));
     }
 }

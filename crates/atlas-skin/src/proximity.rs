@@ -337,4 +337,30 @@ mod tests {
             .iter()
             .all(|&f| spheres.centres[f as usize].distance(DVec3::Z) < 0.5));
     }
+
+    #[test]
+    fn grid_nearest_distance_matches_a_full_scan() {
+        let (mesh, _) = crate::shapes::bent_cylinder(0.5, 3.0, 70.0, 24, 12);
+        let spheres = FaceSpheres::new(&mesh);
+        let full = |p: DVec3| {
+            (0..mesh.triangle_count())
+                .map(|f| {
+                    let [a, b, c] = mesh.corners(f);
+                    point_triangle_distance(p, a, b, c)
+                })
+                .fold(f64::INFINITY, f64::min)
+        };
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        for _ in 0..200 {
+            let mut next = || {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                (state >> 11) as f64 / (1u64 << 53) as f64
+            };
+            let p = DVec3::new(next() * 5.0 - 1.5, next() * 7.0 - 1.0, next() * 3.0 - 1.5);
+            let (grid, scan) = (spheres.nearest_distance(&mesh, p), full(p));
+            assert!((grid - scan).abs() < 1e-12, "{p}: {grid} vs {scan}");
+        }
+    }
 }

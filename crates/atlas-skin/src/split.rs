@@ -2,7 +2,7 @@
 //! the intersected triangles as boundary faces swallows coarse meshes; splitting them keeps
 //! the regions separated by the exact curve).
 //!
-//! The curves must not cross or touch (the conflict rule of [`crate::decompose`]), but
+//! The curves must not cross or touch (the conflict rule of [`crate::decompose()`]), but
 //! several may pass through one face, as on a coarse mesh. Each face becomes the polygon of
 //! its corners and the curve points on its edges (in boundary order), cut along every chord
 //! a curve draws in it; chords that do not cross split a convex polygon into convex
@@ -194,11 +194,15 @@ mod tests {
     fn split_by(mesh: &SurfaceMesh, planes: &[Plane]) -> SplitSurface {
         let topology = Topology::new(mesh);
         let snap = vertex_snap_distances(mesh, &topology, 0.01);
-        let mut domain =
-            SectionDomain::new(mesh, &topology, (0..mesh.triangle_count() as u32).collect());
+        let mut domain = SectionDomain::new(
+            mesh,
+            &topology,
+            &snap,
+            (0..mesh.triangle_count() as u32).collect(),
+        );
         let curves: Vec<SectionCurve> = planes
             .iter()
-            .flat_map(|plane| domain.closed_sections(mesh, &topology, &snap, plane))
+            .flat_map(|plane| domain.closed_sections(&topology, plane))
             .collect();
         split_along_curves(mesh, &topology, &curves.iter().collect::<Vec<_>>())
     }

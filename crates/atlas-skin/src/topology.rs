@@ -241,7 +241,10 @@ impl MeshStats {
         let degenerate_triangles = (0..mesh.triangle_count())
             .filter(|&f| {
                 let t = mesh.triangles[f];
-                t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || mesh.triangle_area(f) <= 1e-12 * diag2
+                t[0] == t[1]
+                    || t[1] == t[2]
+                    || t[0] == t[2]
+                    || mesh.triangle_area(f) <= 1e-12 * diag2
             })
             .count();
         let per_component: Vec<ComponentStats> = per

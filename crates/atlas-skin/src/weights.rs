@@ -13,8 +13,8 @@
 //!    Both give ½ on a curve, so λ_i is continuous across it; regions with λ_i ≤ 0 are not
 //!    related.
 //! 2. **Blend** the related regions: ω_i from the λ_i by [`blend_regions`].
-//! 3. **Chain weights inside a region.** A region holding several joints has a soft
-//!    boundary for each joint after the first (the bound one). Joint c's soft boundary
+//! 3. **Chain weights inside a region.** A region is bound to its first joint; each other
+//!    joint of the region with a soft boundary also moves part of it. Joint c's soft boundary
 //!    (plane point o_c, normal n_c toward its child, half-width w_c) gives
 //!    s_c(p) = β(clamp((w_c + n_c·(p − o_c)) / (2 w_c), 0, 1)) on its child side and 0
 //!    elsewhere. The region's joints form a tree (each soft joint under its nearest
@@ -27,7 +27,8 @@
 //!    near the joint) without crossing the far edge of the band (n_c·(p − o_c) ≤ −w_c) or
 //!    leaving the region and its overlaps. A plane through a shoulder therefore never
 //!    reaches a thigh that the hand touches, and a soft boundary acts only inside its own
-//!    region: the surface-distance guarantee of §3.3 holds for soft boundaries too.
+//!    region: the surface-distance guarantee of §3.3 holds for soft boundaries too. A soft
+//!    boundary with no cross-section near its joint is inactive (see `soft_sides`).
 //! 4. **Fallback.** A vertex that no region with joints reaches (a loose piece, a
 //!    degenerate bit, a region without joints) copies the weights of the nearest weighted
 //!    vertex along the surface's edges (Dijkstra) when its component has one, and is bound

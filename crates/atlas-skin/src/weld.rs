@@ -132,7 +132,7 @@ mod tests {
             Vec3::ZERO,
             Vec3::X,
             Vec3::Y,
-            Vec3::X,               // duplicate of 1 across a seam
+            Vec3::X, // duplicate of 1 across a seam
             Vec3::new(1.0, 1.0, 0.0),
             Vec3::new(5.0, 5.0, 5.0), // referenced by nothing
         ];

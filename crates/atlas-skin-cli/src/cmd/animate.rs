@@ -2,8 +2,9 @@
 //! its skeleton (any glTF viewer plays it) or as a sequence of posed OBJ meshes.
 //!
 //! Every BVH frame is retargeted onto the character's rig by joint names
-//! ([`atlas_skin_runtime::retarget`]); the animation has one LINEAR rotation track per
-//! matched joint and a translation track for the joint matched to the motion's root.
+//! ([`atlas_skin_runtime::retarget`]); the animation has one LINEAR track, one key per
+//! frame, for every joint rotation and translation the motion changes (in practice: the
+//! matched joints' rotations and the root's translation).
 
 use super::pose::{write_mesh, BvhMotion, Posable};
 use crate::input::InputArgs;
@@ -32,7 +33,7 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let character = args.input.load()?;
+    let character = args.input.load_skinned()?;
     let motion = BvhMotion::read(&args.bvh)?;
     let is_obj = args
         .output

@@ -98,7 +98,7 @@ pub struct BenchReport {
 pub fn run(args: Args) -> Result<()> {
     ensure!(args.threads >= 1, "--threads must be at least 1");
     ensure!(args.frames >= 1, "--frames must be at least 1");
-    let character = args.input.load()?;
+    let character = args.input.load_skinned()?;
     let posable = Posable::new(&character)?;
     let weights = character
         .reference_weights

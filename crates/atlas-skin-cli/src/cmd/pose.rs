@@ -67,7 +67,7 @@ pub struct PoseSource {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let character = args.input.load()?;
+    let character = args.input.load_skinned()?;
     let posable = Posable::new(&character)?;
     let local = match (&args.source.anim, &args.source.bvh, &args.source.pose) {
         (Some(name), _, _) => posable.sample_clip(find_clip(&character.clips, name)?, args.time)?,
@@ -444,11 +444,11 @@ mod tests {
         });
         let rotations = parse_pose(&pose, &rig()).unwrap();
         assert_eq!(rotations[0], Quat::IDENTITY);
-        assert!(rotations[1].angle_between(Quat::from_rotation_z(90f32.to_radians())) < 1e-6);
+        assert!(rotations[1].abs_diff_eq(Quat::from_rotation_z(90f32.to_radians()), 1e-6));
         let xyz = json!({"arm": {"euler_degrees": [30.0, 40.0, 0.0], "order": "XYZ"}});
         let expected =
             Quat::from_rotation_x(30f32.to_radians()) * Quat::from_rotation_y(40f32.to_radians());
-        assert!(parse_pose(&xyz, &rig()).unwrap()[1].angle_between(expected) < 1e-6);
+        assert!(parse_pose(&xyz, &rig()).unwrap()[1].abs_diff_eq(expected, 1e-6));
     }
 
     #[test]

@@ -244,16 +244,16 @@ fn report(
 
     let counts = &skinned.counts;
     let mut warnings = character.warnings.clone();
-    let fallback = &counts.weights;
-    if fallback.unreachable > 0 {
+    let weight_counts = &counts.weights;
+    if weight_counts.unreachable > 0 {
         warnings.push(format!(
             "{} surface vertices lie where no region with joints reaches: {} took the weights \
              of the nearest weighted vertex along the surface, {} those of the nearest bone",
-            fallback.unreachable, fallback.from_surface, fallback.from_bone
+            weight_counts.unreachable, weight_counts.from_surface, weight_counts.from_bone
         ));
     }
-    if !fallback.inactive_soft_joints.is_empty() {
-        let names: Vec<&str> = fallback
+    if !weight_counts.inactive_soft_joints.is_empty() {
+        let names: Vec<&str> = weight_counts
             .inactive_soft_joints
             .iter()
             .map(|&j| decomposition.joints[j as usize].name.as_str())
@@ -280,8 +280,8 @@ fn report(
             "surface_vertices": counts.surface_vertices,
             "joints": counts.joints,
             "regions": decomposition.regions.len(),
-            "unreachable_vertices": fallback.unreachable,
-            "fallback_weighted_vertices": fallback.from_surface + fallback.from_bone
+            "unreachable_vertices": weight_counts.unreachable,
+            "fallback_weighted_vertices": weight_counts.from_surface + weight_counts.from_bone
                 + counts.unreferenced_stored_vertices,
             "max_influences": skinned.weights.max_influences(),
         },

@@ -139,6 +139,17 @@ impl GlbBuilder {
         self.push_accessor(view, component, type_name, count, None)
     }
 
+    /// The document's top-level object and the binary buffer, for a pass that rebuilds
+    /// both (see [`GlbBuilder::from_parts`]).
+    pub fn into_parts(self) -> (Map<String, Value>, Vec<u8>) {
+        (self.json, self.bin)
+    }
+
+    /// A builder continuing from `json` and its binary buffer `bin`.
+    pub fn from_parts(json: Map<String, Value>, bin: Vec<u8>) -> Self {
+        Self { json, bin }
+    }
+
     /// The finished `.glb`: one buffer holding everything appended.
     pub fn finish(mut self) -> Vec<u8> {
         if self.bin.is_empty() {

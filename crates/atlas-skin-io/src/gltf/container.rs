@@ -52,9 +52,9 @@ fn read_file(path: &Path) -> Result<Vec<u8>, IoError> {
             path: path.to_path_buf(),
         });
     }
-    let bytes = std::fs::read(path).map_err(|source| IoError::Read {
+    let bytes = std::fs::read(path).map_err(|cause| IoError::Read {
         path: path.to_path_buf(),
-        source,
+        cause,
     })?;
     if bytes.is_empty() {
         return Err(IoError::Empty {

@@ -14,6 +14,7 @@ mod document;
 mod new_document;
 mod nodes;
 mod output;
+mod prune;
 mod read;
 mod rewrite;
 mod write;

@@ -26,9 +26,9 @@ pub(crate) fn write_atomically(
             path: out.to_path_buf(),
         });
     }
-    let write_error = |source| IoError::Write {
+    let write_error = |cause| IoError::Write {
         path: out.to_path_buf(),
-        source,
+        cause,
     };
     let name = out
         .file_name()

@@ -396,9 +396,9 @@ fn read_skeleton(
             NO_PARENT
         })
         .collect();
-    Skeleton::new(names, parents, inverse_bind).map_err(|source| IoError::Skeleton {
+    Skeleton::new(names, parents, inverse_bind).map_err(|cause| IoError::Skeleton {
         path: doc.path.to_path_buf(),
-        source,
+        cause,
     })
 }
 

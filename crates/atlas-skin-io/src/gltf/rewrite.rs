@@ -3,6 +3,7 @@
 use super::animation::append_clips;
 use super::builder::GlbBuilder;
 use super::container::load_uri;
+use super::prune::{drop_orphans, References};
 use super::write::{merge_asset_extras, pack_weights, push_weight_accessors, WriteOptions};
 use super::GltfSource;
 use crate::{Character, IoError};
@@ -18,7 +19,8 @@ use std::path::Path;
 /// bufferViews. For each POSITION accessor read into `character.mesh`, new JOINTS_n and
 /// WEIGHTS_n accessors are made once and put on every primitive of the skinned meshes
 /// using that POSITION accessor; JOINTS_n/WEIGHTS_n sets beyond the new ones are removed.
-/// The old weight accessors stay in the document, unused.
+/// The accessors, bufferViews and bytes only the old weights used are then dropped (see
+/// [`drop_orphans`]); what the input itself left unreferenced stays.
 pub(crate) fn rewrite_document(
     character: &Character,
     source: &GltfSource,
@@ -34,6 +36,7 @@ pub(crate) fn rewrite_document(
         ));
     };
     let mut builder = GlbBuilder::new(json);
+    let input_references = References::of_input(builder.json_mut());
     copy_buffer_views(&mut builder, source, input)?;
     embed_images(&mut builder, input)?;
 
@@ -64,7 +67,7 @@ pub(crate) fn rewrite_document(
     if let Some(extras) = &options.extras {
         merge_asset_extras(builder.json_mut(), extras);
     }
-    Ok(builder.finish())
+    Ok(drop_orphans(builder, input_references.as_ref()).finish())
 }
 
 /// Copies every bufferView's bytes into the output buffer and points the view at it.

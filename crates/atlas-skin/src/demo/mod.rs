@@ -141,20 +141,26 @@ fn layout() -> (Vec<Joint>, Vec<RoundCone>) {
             RoundCone::new(m(v(0.74, 1.40, 0.0)), m(v(0.84, 1.40, 0.0)), 0.05, 0.05)
                 .squashed(v(1.0, 0.45, 1.0)),
         );
-        // Three fingers fanned in the horizontal plane, and a thumb pointing forward.
+        // Three fingers fanned in the horizontal plane, and a thumb pointing forward. Each
+        // digit's first joint sits `knuckle` along it from its base, where the digit has left
+        // the palm: a section there rings one digit, not the palm with the others' bones.
         let digits = [
-            ("index", v(0.84, 1.40, 0.045), 22.0_f64, 0.13, 0.021),
-            ("middle", v(0.84, 1.40, 0.0), 0.0, 0.14, 0.021),
-            ("ring", v(0.84, 1.40, -0.045), -22.0, 0.12, 0.020),
-            ("thumb", v(0.76, 1.40, 0.035), 70.0, 0.10, 0.022),
+            ("index", v(0.84, 1.40, 0.045), 22.0_f64, 0.13, 0.021, 0.05),
+            ("middle", v(0.84, 1.40, 0.0), 0.0, 0.14, 0.021, 0.055),
+            ("ring", v(0.84, 1.40, -0.045), -22.0, 0.12, 0.020, 0.05),
+            ("thumb", v(0.76, 1.40, 0.035), 70.0, 0.10, 0.022, 0.045),
         ];
-        for (digit, base, degrees, length, radius) in digits {
+        for (digit, base, degrees, length, radius, knuckle) in digits {
             let direction = v(degrees.to_radians().cos(), 0.0, degrees.to_radians().sin());
-            let first = add(&name(&format!("{digit}1")), Some(wrist), m(base));
+            let first = add(
+                &name(&format!("{digit}1")),
+                Some(wrist),
+                m(base + direction * knuckle),
+            );
             add(
                 &name(&format!("{digit}2")),
                 Some(first),
-                m(base + direction * length * 0.5),
+                m(base + direction * (knuckle + length) * 0.5),
             );
             parts.push(RoundCone::new(
                 m(base),

@@ -1,0 +1,115 @@
+//! `atlas-skin bench` and `atlas-skin pose` without INPUT: both run on the built-in demo
+//! character skinned by the method.
+
+use atlas_skin::demo::{demo_character, DEFAULT_STEP};
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn atlas_skin(args: &[&str]) -> String {
+    let output = Command::new(env!("CARGO_BIN_EXE_atlas-skin"))
+        .args(args)
+        .output()
+        .expect("run atlas-skin");
+    assert!(
+        output.status.success(),
+        "atlas-skin {args:?} failed: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    String::from_utf8(output.stdout).expect("UTF-8 output")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("atlas-skin-bench-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temporary directory");
+    dir.join(name)
+}
+
+fn obj_positions(path: &Path) -> Vec<[f32; 3]> {
+    std::fs::read_to_string(path)
+        .expect("OBJ written")
+        .lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            let v: Vec<f32> = l
+                .split_whitespace()
+                .map(|x| x.parse().expect("a number"))
+                .collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect()
+}
+
+/// The JSON report has every figure the issue names, for the requested size and threads,
+/// and a frame allocates nothing.
+#[test]
+fn bench_runs_on_the_demo_character() {
+    let text = atlas_skin(&[
+        "bench",
+        "--json",
+        "--threads",
+        "2",
+        "--vertices",
+        "20000",
+        "--frames",
+        "3",
+    ]);
+    let report: Value = serde_json::from_str(&text).expect("one JSON object");
+    assert_eq!(report["vertices"], 20_000, "{report}");
+    assert_eq!(report["threads"], 2, "{report}");
+    assert_eq!(report["allocations_per_frame"], 0.0, "{report}");
+    let influences = report["influences"].as_u64().expect("influences");
+    assert!((1..=4).contains(&influences), "{report}");
+    for key in [
+        "lbs_vertices_per_second",
+        "dqs_vertices_per_second",
+        "memcpy_bytes_per_second",
+        "bandwidth_fraction",
+        "dqs_bandwidth_fraction",
+    ] {
+        let value = report[key].as_f64().unwrap_or(f64::NAN);
+        assert!(value.is_finite() && value > 0.0, "{key}: {report}");
+    }
+}
+
+/// `pose` without INPUT deforms the demo character: the rest pose (an empty pose file) is
+/// the demo mesh within 1e-5 of its bounding-box diagonal, a random pose moves it.
+#[test]
+fn pose_runs_on_the_demo_character() {
+    let demo = demo_character(DEFAULT_STEP);
+    let (min, max) = demo.positions.iter().fold(
+        (glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN)),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+    );
+    let diagonal = (max - min).length();
+    let empty = scratch("empty.json");
+    std::fs::write(&empty, "{}").expect("pose file written");
+    let rest = scratch("rest.obj");
+    let random = scratch("random.obj");
+    for (source, out) in [
+        (["--pose", empty.to_str().expect("UTF-8 path")], &rest),
+        (["--random", "5"], &random),
+    ] {
+        let mut args = vec!["pose"];
+        args.extend(source);
+        args.extend(["-o", out.to_str().expect("UTF-8 path")]);
+        atlas_skin(&args);
+    }
+    let distance = |a: [f32; 3], b: glam::Vec3| (glam::Vec3::from_array(a) - b).length();
+    let rest = obj_positions(&rest);
+    assert_eq!(rest.len(), demo.positions.len());
+    let worst = rest
+        .iter()
+        .zip(&demo.positions)
+        .map(|(&a, &b)| distance(a, b))
+        .fold(0.0f32, f32::max);
+    assert!(worst <= 1e-5 * diagonal, "rest pose moved by {worst}");
+    let random = obj_positions(&random);
+    assert_eq!(random.len(), demo.positions.len());
+    let moved = random
+        .iter()
+        .zip(&demo.positions)
+        .map(|(&a, &b)| distance(a, b))
+        .fold(0.0f32, f32::max);
+    assert!(moved > 0.05 * diagonal, "a random pose moved by {moved} only");
+}
