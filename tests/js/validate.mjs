@@ -2,8 +2,10 @@
 //
 // Usage: node tests/js/validate.mjs FILE.glb [FILE.gltf ...]
 // Prints one JSON line per file:
-//   {"file", "errors", "warnings", "infos", "hints", "messages": [{code, severity, pointer, message}]}
-// ("messages" lists the first 20 errors and warnings). Exit code 1 when any file has an error or
+//   {"file", "errors", "warnings", "infos", "hints", "messages": [{code, severity, pointer, message}],
+//    "codes": {"severity:CODE": count}}
+// ("messages" lists the first 20 errors and warnings; "codes" counts every message by
+// "severity:CODE", e.g. {"warning:NODE_SKINNED_MESH_NON_ROOT": 1}). Exit code 1 when any file has an error or
 // cannot be read or parsed, 2 on bad usage.
 
 import { readFile } from "node:fs/promises";
@@ -27,6 +29,11 @@ async function validate(file) {
       ),
   });
   const issues = report.issues;
+  const codes = {};
+  for (const m of issues.messages) {
+    const key = `${SEVERITY[m.severity] ?? m.severity}:${m.code}`;
+    codes[key] = (codes[key] ?? 0) + 1;
+  }
   return {
     file,
     errors: issues.numErrors,
@@ -42,6 +49,7 @@ async function validate(file) {
         pointer: m.pointer ?? null,
         message: m.message,
       })),
+    codes,
   };
 }
 

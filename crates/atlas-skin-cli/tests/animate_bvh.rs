@@ -2,35 +2,20 @@
 //! own comes back as a glTF animation that reproduces every joint's motion, passes the
 //! Khronos validator, and as an OBJ sequence with one posed mesh per frame.
 
+mod support;
+
+use atlas_skin_corpus::{motion_path, node_check};
 use atlas_skin_io::gltf::{write_skinned_glb, WriteOptions};
 use atlas_skin_io::{Character, TriangleMesh};
 use atlas_skin_runtime::{Rig, Trs, VertexWeights};
 use glam::{Mat4, Vec3};
-use std::path::{Path, PathBuf};
-use std::process::Command;
-
-const MOTION: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../../../shared/data/motion/walk.bvh"
-);
-const WORKSPACE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("atlas-skin-animate-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temporary directory");
-    dir.join(name)
-}
+use std::path::Path;
+use support::{atlas_skin_ok, out_dir};
 
 /// A character made of one small tetrahedron at every joint of the BVH skeleton, each
 /// bound rigidly to its joint, written as a skinned glb.
 fn bvh_character(out: &Path) {
-    let motion = Path::new(MOTION);
-    assert!(
-        motion.exists(),
-        "motion file {} is missing",
-        motion.display()
-    );
-    let skeleton = atlas_skin_io::bvh::read(motion).expect("read BVH skeleton");
+    let skeleton = atlas_skin_io::bvh::read(&motion_path("walk.bvh")).expect("read BVH skeleton");
     let corners = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
     let mut mesh = TriangleMesh::default();
     let mut rows = Vec::new();
@@ -53,21 +38,17 @@ fn bvh_character(out: &Path) {
     .expect("write glb");
 }
 
+/// `atlas-skin animate INPUT --bvh walk.bvh -o OUT`.
 fn animate(input: &Path, out: &Path) {
-    let output = Command::new(env!("CARGO_BIN_EXE_atlas-skin"))
-        .arg("animate")
-        .arg(input)
-        .arg("--bvh")
-        .arg(MOTION)
-        .arg("-o")
-        .arg(out)
-        .output()
-        .expect("run atlas-skin");
-    assert!(
-        output.status.success(),
-        "animate failed: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
+    let motion = motion_path("walk.bvh");
+    atlas_skin_ok(&[
+        Path::new("animate"),
+        input,
+        Path::new("--bvh"),
+        &motion,
+        Path::new("-o"),
+        out,
+    ]);
 }
 
 /// World position of every joint of `rig` in a pose.
@@ -82,12 +63,14 @@ fn joint_positions(rig: &Rig, local: &[Trs]) -> Vec<Vec3> {
 
 #[test]
 fn animation_reproduces_the_motion_on_its_own_skeleton() {
-    let input = scratch("character.glb");
-    let out = scratch("animated.glb");
+    let dir = out_dir("animate_gltf");
+    let input = dir.join("character.glb");
+    let out = dir.join("animated.glb");
     bvh_character(&input);
     animate(&input, &out);
 
-    let (_, source_rig, source_clip) = atlas_skin_io::bvh::read_motion(Path::new(MOTION)).unwrap();
+    let (_, source_rig, source_clip) =
+        atlas_skin_io::bvh::read_motion(&motion_path("walk.bvh")).unwrap();
     let animated = atlas_skin_io::load_character(&out, &Default::default()).expect("read output");
     let rig = animated.rig.as_ref().expect("rig");
     let clip = animated.clips.last().expect("an animation");
@@ -108,32 +91,25 @@ fn animation_reproduces_the_motion_on_its_own_skeleton() {
         }
     }
 
-    let validator = Command::new("node")
-        .current_dir(WORKSPACE)
-        .arg("tests/js/validate.mjs")
-        .arg(&out)
-        .output()
-        .expect("run node (install it with scripts/install-test-deps)");
-    assert!(
-        validator.status.success(),
-        "validator: {}",
-        String::from_utf8_lossy(&validator.stdout)
-    );
+    for report in node_check("validate.mjs", &[&out]) {
+        assert_eq!(report["errors"], 0, "validator: {report}");
+    }
 }
 
 #[test]
 fn obj_sequence_has_one_posed_mesh_per_frame() {
-    let input = scratch("sequence-character.glb");
+    let dir = out_dir("animate_obj");
+    let input = dir.join("sequence-character.glb");
     bvh_character(&input);
-    let out = scratch("sequence/walk.obj");
+    let out = dir.join("sequence/walk.obj");
     std::fs::create_dir_all(out.parent().unwrap()).unwrap();
     animate(&input, &out);
-    let (_, _, clip) = atlas_skin_io::bvh::read_motion(Path::new(MOTION)).unwrap();
+    let (_, _, clip) = atlas_skin_io::bvh::read_motion(&motion_path("walk.bvh")).unwrap();
     let frames = clip.tracks[0].times.len();
     let count = std::fs::read_dir(out.parent().unwrap()).unwrap().count();
     assert_eq!(count, frames);
-    let first = std::fs::read_to_string(scratch("sequence/walk_0001.obj")).expect("first frame");
-    let last = std::fs::read_to_string(scratch(&format!("sequence/walk_{frames:04}.obj")))
+    let first = std::fs::read_to_string(dir.join("sequence/walk_0001.obj")).expect("first frame");
+    let last = std::fs::read_to_string(dir.join(format!("sequence/walk_{frames:04}.obj")))
         .expect("last frame");
     assert_ne!(first, last, "the mesh moves");
 }

@@ -111,5 +111,8 @@ fn pose_runs_on_the_demo_character() {
         .zip(&demo.positions)
         .map(|(&a, &b)| distance(a, b))
         .fold(0.0f32, f32::max);
-    assert!(moved > 0.05 * diagonal, "a random pose moved by {moved} only");
+    assert!(
+        moved > 0.05 * diagonal,
+        "a random pose moved by {moved} only"
+    );
 }

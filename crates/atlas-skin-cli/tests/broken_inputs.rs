@@ -1,10 +1,12 @@
 //! Broken inputs give a clear error: `atlas-skin inspect` and `atlas-skin skin` exit
 //! non-zero, stderr names the file and the problem, nothing panics and `skin` writes no file.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod support;
 
-const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data");
+use atlas_skin_corpus::RIGGEDSIMPLE;
+use std::path::{Path, PathBuf};
+use std::process::Output;
+use support::{atlas_skin, out_dir};
 
 /// One broken input: the files to write (name, bytes) into a fresh folder, the
 /// `inspect` arguments after the subcommand (`{dir}` is replaced by that folder), the file
@@ -18,7 +20,7 @@ struct Case {
 }
 
 fn corpus_glb() -> Vec<u8> {
-    let path = Path::new(DATA).join("models/riggedsimple/RiggedSimple.glb");
+    let path = RIGGEDSIMPLE.input_path();
     std::fs::read(&path).unwrap_or_else(|e| panic!("corpus file {}: {e}", path.display()))
 }
 
@@ -190,15 +192,7 @@ fn case_dir(subcommand: &str, case: &str) -> PathBuf {
         .chars()
         .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })
         .collect();
-    let dir = std::env::temp_dir()
-        .join(format!(
-            "atlas-skin-broken-{subcommand}-{}",
-            std::process::id()
-        ))
-        .join(format!("broken-{slug}"));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    out_dir(&format!("broken-{subcommand}/broken-{slug}"))
 }
 
 fn run(subcommand: &[&str], case: &Case, dir: &Path, trailing: &[&str]) -> Output {
@@ -206,16 +200,17 @@ fn run(subcommand: &[&str], case: &Case, dir: &Path, trailing: &[&str]) -> Outpu
         std::fs::write(dir.join(name), bytes).unwrap();
     }
     let dir_text = dir.to_str().unwrap();
-    Command::new(env!("CARGO_BIN_EXE_atlas-skin"))
-        .args(subcommand)
-        .args(
+    let args: Vec<String> = subcommand
+        .iter()
+        .map(|a| a.to_string())
+        .chain(
             case.args
                 .iter()
                 .chain(trailing)
                 .map(|a| a.replace("{dir}", dir_text)),
         )
-        .output()
-        .expect("run atlas-skin")
+        .collect();
+    atlas_skin(&args)
 }
 
 /// Checks one output: failure, the file and problem in stderr, no panic.

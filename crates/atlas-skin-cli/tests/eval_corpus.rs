@@ -2,121 +2,33 @@
 //! the reference weights themselves (unchanged, reordered, with joints swapped) give the
 //! figures worked out from the data, and the JSON keys are the documented contract.
 
+mod support;
+
+use atlas_skin_corpus::{Model, ARM, MAKEHUMAN, MODELS, RIGGEDSIMPLE};
 use atlas_skin_io::gltf::{write_skinned_glb, WriteOptions};
-use atlas_skin_io::{load_character, Character, LoadOptions, TriangleMesh};
+use atlas_skin_io::{load_character, Character, TriangleMesh};
 use atlas_skin_runtime::VertexWeights;
 use serde_json::Value;
+use std::ffi::OsString;
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use support::{atlas_skin_ok, out_dir};
 
-const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/models");
-
-/// A corpus model with reference weights: folder, input, and the reading options as
-/// (flag, file) pairs; files are relative to the folder except the group name.
-struct Model {
-    name: &'static str,
-    input: &'static str,
-    skeleton: Option<&'static str>,
-    group: Option<&'static str>,
-    weights: Option<&'static str>,
-}
-
-const fn gltf(name: &'static str, input: &'static str) -> Model {
-    Model {
-        name,
-        input,
-        skeleton: None,
-        group: None,
-        weights: None,
-    }
-}
-
-const GLTF_MODELS: [Model; 4] = [
-    gltf("cesiumman", "CesiumMan.glb"),
-    gltf("riggedfigure", "RiggedFigure.glb"),
-    gltf("riggedsimple", "RiggedSimple.glb"),
-    gltf("simpleskin", "SimpleSkin.gltf"),
-];
-
-const ARM: Model = Model {
-    name: "arm",
-    input: "arm.obj",
-    skeleton: Some("arm.tgf"),
-    group: None,
-    weights: Some("arm-weights.dmat"),
-};
-
-const MAKEHUMAN: Model = Model {
-    name: "makehuman",
-    input: "base.obj",
-    skeleton: Some("default.mhskel"),
-    group: Some("body"),
-    weights: Some("default_weights.mhw"),
-};
-
-impl Model {
-    fn folder(&self) -> PathBuf {
-        let folder = Path::new(DATA).join(self.name);
-        assert!(
-            folder.is_dir(),
-            "the corpus is missing: {}",
-            folder.display()
-        );
-        folder
-    }
-
-    fn load(&self) -> Character {
-        let folder = self.folder();
-        let options = LoadOptions {
-            skeleton: self.skeleton.map(|s| folder.join(s)),
-            group: self.group.map(String::from),
-            weights: self.weights.map(|w| folder.join(w)),
-        };
-        load_character(&folder.join(self.input), &options).unwrap()
-    }
-
-    /// `eval` arguments naming this model as the reference.
-    fn reference_args(&self) -> Vec<String> {
-        let folder = self.folder();
-        let path = |f: &str| folder.join(f).display().to_string();
-        let mut args = vec![path(self.input)];
-        for (flag, value) in [
-            ("--skeleton", self.skeleton.map(path)),
-            ("--group", self.group.map(String::from)),
-            ("--weights", self.weights.map(path)),
-        ] {
-            if let Some(value) = value {
-                args.extend([flag.to_string(), value]);
-            }
-        }
-        args
-    }
-}
-
-fn out_path(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_TARGET_TMPDIR")).join(name)
+/// The model's input with its reference weights.
+fn load(model: &Model) -> Character {
+    load_character(&model.input_path(), &model.load_options(true)).unwrap()
 }
 
 fn eval_json(reference: &Model, candidate: &Path, extra: &[&str]) -> Value {
-    let output = Command::new(env!("CARGO_BIN_EXE_atlas-skin"))
-        .arg("eval")
-        .args(reference.reference_args())
-        .arg(candidate)
-        .arg("--json")
-        .args(extra)
-        .output()
-        .unwrap();
-    assert!(
-        output.status.success(),
-        "eval on {} failed: {}",
-        reference.name,
-        String::from_utf8_lossy(&output.stderr)
-    );
+    let mut args: Vec<OsString> = vec!["eval".into()];
+    args.extend(reference.input_args(true));
+    args.extend([candidate.into(), "--json".into()]);
+    args.extend(extra.iter().map(OsString::from));
+    let output = atlas_skin_ok(&args);
     serde_json::from_slice(&output.stdout).unwrap()
 }
 
-fn write_candidate(character: &Character, weights: &VertexWeights, name: &str) -> PathBuf {
-    let path = out_path(name);
+/// Writes `weights` on `character` as the skinned glb `path`.
+fn write_candidate(character: &Character, weights: &VertexWeights, path: PathBuf) -> PathBuf {
     let options = WriteOptions {
         max_influences: weights.max_influences().max(1),
         ..WriteOptions::default()
@@ -166,12 +78,13 @@ fn keys(value: &Value) -> Vec<&str> {
 
 #[test]
 fn reference_weights_as_candidate_give_zeros_and_the_json_contract_holds() {
-    for model in &GLTF_MODELS {
-        let character = model.load();
+    let dir = out_dir("eval_same");
+    for model in MODELS.iter().filter(|m| m.is_gltf()) {
+        let character = load(model);
         let candidate = write_candidate(
             &character,
             reference_weights(&character),
-            &format!("eval_same_{}.glb", model.name),
+            dir.join(format!("{}.glb", model.name)),
         );
         let e = eval_json(model, &candidate, &[]);
         assert_zero(&e, model.name);
@@ -216,9 +129,13 @@ fn reference_weights_as_candidate_give_zeros_and_the_json_contract_holds() {
 
 #[test]
 fn makehuman_pruned_reference_as_candidate_gives_zeros() {
-    let character = MAKEHUMAN.load();
+    let character = load(&MAKEHUMAN);
     let pruned = reference_weights(&character).pruned(4);
-    let candidate = write_candidate(&character, &pruned, "eval_same_makehuman.glb");
+    let candidate = write_candidate(
+        &character,
+        &pruned,
+        out_dir("eval_same_makehuman").join("makehuman.glb"),
+    );
     let e = eval_json(
         &MAKEHUMAN,
         &candidate,
@@ -234,7 +151,8 @@ fn makehuman_pruned_reference_as_candidate_gives_zeros() {
 
 #[test]
 fn a_reordered_candidate_still_matches() {
-    let character = ARM.load();
+    let dir = out_dir("eval_reversed");
+    let character = load(&ARM);
     let weights = reference_weights(&character);
     // Reverse the vertex order (and the triangles' indices with it).
     let n = character.mesh.positions.len() as u32;
@@ -247,10 +165,10 @@ fn a_reordered_candidate_still_matches() {
             .map(|t| t.map(|v| n - 1 - v))
             .collect(),
     };
-    let mut reordered = Character::new(out_path("arm_reversed.obj"), reordered_mesh);
+    let mut reordered = Character::new(dir.join("arm_reversed.obj"), reordered_mesh);
     reordered.skeleton = character.skeleton.clone();
     let reversed_weights = VertexWeights::from_rows((0..n as usize).rev().map(|v| weights.row(v)));
-    let candidate = write_candidate(&reordered, &reversed_weights, "eval_reversed_arm.glb");
+    let candidate = write_candidate(&reordered, &reversed_weights, dir.join("arm.glb"));
     let e = eval_json(&ARM, &candidate, &[]);
     assert_zero(&e, "arm reversed");
     assert_eq!(e["matched"].as_u64(), Some(u64::from(n)));
@@ -258,14 +176,18 @@ fn a_reordered_candidate_still_matches() {
 
 #[test]
 fn swapped_joints_give_the_weight_difference_worked_out_from_the_data() {
-    let model = &GLTF_MODELS[2]; // riggedsimple: two joints
-    let character = model.load();
+    let model = &RIGGEDSIMPLE; // two joints
+    let character = load(model);
     let weights = reference_weights(&character);
     assert_eq!(character.skeleton.as_ref().unwrap().len(), 2);
     let swapped = VertexWeights::from_rows(
         (0..weights.vertex_count()).map(|v| weights.row(v).map(|(j, w)| (1 - j, w))),
     );
-    let candidate = write_candidate(&character, &swapped, "eval_swapped_riggedsimple.glb");
+    let candidate = write_candidate(
+        &character,
+        &swapped,
+        out_dir("eval_swapped").join("riggedsimple.glb"),
+    );
     let e = eval_json(model, &candidate, &[]);
     // Row (a, b) normalised against (b, a): d = 2 |a − b| / (a + b).
     let d: Vec<f64> = (0..weights.vertex_count())

@@ -1,9 +1,12 @@
 //! `atlas-skin eval` on small glb files written by hand: the validity counts and weight
 //! differences of a candidate with every defect, worked out by hand.
 
+mod support;
+
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
+use support::{atlas_skin, atlas_skin_ok};
 
 /// A unit square of 4 vertices (2 triangles) skinned to two joints, "root" and "tip".
 fn square_glb(joints: [[u8; 4]; 4], weights: [[f32; 4]; 4]) -> Vec<u8> {
@@ -92,22 +95,17 @@ fn write(name: &str, bytes: &[u8]) -> PathBuf {
     path
 }
 
+/// The arguments of `atlas-skin eval REFERENCE CANDIDATE --json`.
+fn eval_args<'a>(reference: &'a Path, candidate: &'a Path) -> [&'a Path; 4] {
+    [Path::new("eval"), reference, candidate, Path::new("--json")]
+}
+
 fn eval(reference: &Path, candidate: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_atlas-skin"))
-        .arg("eval")
-        .args([reference, candidate])
-        .arg("--json")
-        .output()
-        .unwrap()
+    atlas_skin(&eval_args(reference, candidate))
 }
 
 fn eval_json(reference: &Path, candidate: &Path) -> Value {
-    let output = eval(reference, candidate);
-    assert!(
-        output.status.success(),
-        "eval failed: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
+    let output = atlas_skin_ok(&eval_args(reference, candidate));
     serde_json::from_slice(&output.stdout).unwrap()
 }
 

@@ -2,39 +2,23 @@
 //! manifest.json: stored and welded vertices, triangles, components, closedness, Euler
 //! characteristic, genus, joint count and every joint's inside flag.
 
+mod support;
+
+use atlas_skin_corpus::{
+    Model, ARM, CESIUMMAN, ELEPHANT, HAND, MAKEHUMAN, RIGGEDFIGURE, RIGGEDSIMPLE, SIMPLESKIN,
+};
 use serde_json::Value;
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::ffi::OsString;
+use support::atlas_skin_ok;
 
-const MODELS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/models");
-
-fn model_file(model: &str, file: &str) -> PathBuf {
-    let path = Path::new(MODELS).join(model).join(file);
-    assert!(path.exists(), "corpus file {} is missing", path.display());
-    path
-}
-
-/// Runs `inspect --json` on `model`'s `mesh` with extra arguments (`--skeleton FILE` and
-/// `--group NAME`, file names relative to the model folder) and checks it against the
-/// manifest.
-fn check(model: &str, mesh: &str, skeleton: Option<&str>, group: Option<&str>) {
-    let mut command = Command::new(env!("CARGO_BIN_EXE_atlas-skin"));
-    command
-        .arg("inspect")
-        .arg("--json")
-        .arg(model_file(model, mesh));
-    if let Some(skeleton) = skeleton {
-        command.arg("--skeleton").arg(model_file(model, skeleton));
-    }
-    if let Some(group) = group {
-        command.args(["--group", group]);
-    }
-    let output = command.output().expect("run atlas-skin");
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(output.status.success(), "{model}: inspect failed: {stderr}");
+/// Runs `inspect --json` on `model` and checks it against the manifest.
+fn check(model: &Model) {
+    let mut args: Vec<OsString> = vec!["inspect".into(), "--json".into()];
+    args.extend(model.input_args(false));
+    let output = atlas_skin_ok(&args);
     let report: Value = serde_json::from_slice(&output.stdout).expect("inspect prints JSON");
-    let text = std::fs::read_to_string(model_file(model, "manifest.json")).unwrap();
-    let manifest: Value = serde_json::from_str(&text).unwrap();
+    let manifest = model.manifest();
+    let model = model.name;
 
     for (key, manifest_key) in [
         ("vertices", "stored_vertex_count"),
@@ -70,45 +54,40 @@ fn check(model: &str, mesh: &str, skeleton: Option<&str>, group: Option<&str>) {
 
 #[test]
 fn arm() {
-    check("arm", "arm.obj", Some("arm.tgf"), None);
+    check(&ARM);
 }
 
 #[test]
 fn elephant() {
-    check("elephant", "elephant.obj", Some("elephant.tgf"), None);
+    check(&ELEPHANT);
 }
 
 #[test]
 fn hand() {
-    check("hand", "hand.mesh", Some("hand.tgf"), None);
+    check(&HAND);
 }
 
 #[test]
 fn makehuman() {
-    check(
-        "makehuman",
-        "base.obj",
-        Some("default.mhskel"),
-        Some("body"),
-    );
+    check(&MAKEHUMAN);
 }
 
 #[test]
 fn cesiumman() {
-    check("cesiumman", "CesiumMan.glb", None, None);
+    check(&CESIUMMAN);
 }
 
 #[test]
 fn riggedfigure() {
-    check("riggedfigure", "RiggedFigure.glb", None, None);
+    check(&RIGGEDFIGURE);
 }
 
 #[test]
 fn riggedsimple() {
-    check("riggedsimple", "RiggedSimple.glb", None, None);
+    check(&RIGGEDSIMPLE);
 }
 
 #[test]
 fn simpleskin() {
-    check("simpleskin", "SimpleSkin.gltf", None, None);
+    check(&SIMPLESKIN);
 }

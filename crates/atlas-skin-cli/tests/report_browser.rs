@@ -4,20 +4,14 @@
 //! to the runtime's reference; on the demo character and MakeHuman skinned by `atlas-skin
 //! skin --html`, on glTF files as they are, and with a BVH motion.
 
+mod support;
+
+use atlas_skin_corpus::{motion_path, node_json, CESIUMMAN, MAKEHUMAN, RIGGEDFIGURE};
 use atlas_skin_runtime::{reference, VertexWeights};
 use glam::{Mat4, Vec3};
-use std::ffi::OsStr;
+use std::ffi::{OsStr, OsString};
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data");
-const WORKSPACE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
-
-fn model(relative: &str) -> PathBuf {
-    let path = Path::new(DATA).join("models").join(relative);
-    assert!(path.is_file(), "missing test data: {}", path.display());
-    path
-}
+use support::atlas_skin_ok as atlas_skin;
 
 fn output_dir() -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("report_browser");
@@ -25,46 +19,14 @@ fn output_dir() -> PathBuf {
     dir
 }
 
-/// Runs `atlas-skin ARGS...` and asserts it succeeds.
-fn atlas_skin(args: &[&OsStr]) {
-    let output = Command::new(env!("CARGO_BIN_EXE_atlas-skin"))
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(
-        output.status.success(),
-        "atlas-skin {args:?}: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-}
-
 /// Runs tests/js/viewer.mjs on the report `html`; returns its whole result. Screenshots go
 /// to the test output folder as NAME-*.png.
 fn run_viewer(name: &str, html: &Path) -> serde_json::Value {
     assert!(
-        Path::new(WORKSPACE)
-            .join("tests/js/node_modules/playwright-core")
-            .is_dir(),
-        "tests/js/node_modules is missing: run scripts/install-test-deps"
-    );
-    assert!(
         Path::new("/usr/bin/chromium").is_file(),
         "chromium is missing: run scripts/install-test-deps"
     );
-    let output = Command::new("node")
-        .current_dir(WORKSPACE)
-        .arg("tests/js/viewer.mjs")
-        .arg(html)
-        .arg(output_dir().join(name))
-        .output()
-        .expect("running node");
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    assert!(
-        output.status.success(),
-        "viewer.mjs failed: {stdout}\n{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    serde_json::from_str(&stdout).expect("viewer.mjs prints JSON")
+    node_json("viewer.mjs", &[html, &output_dir().join(name)])
 }
 
 /// Drives the report `html` in Chromium; returns the checker's `checks` after asserting it
@@ -157,7 +119,7 @@ fn assert_gpu_skinning_matches_reference(checks: &serde_json::Value) {
 
 #[test]
 fn cesiumman_without_a_report_shows_the_file_weights() {
-    let checks = check_in_browser("cesiumman", &model("cesiumman/CesiumMan.glb"), None);
+    let checks = check_in_browser("cesiumman", &CESIUMMAN.input_path(), None);
     assert_gpu_skinning_matches_reference(&checks);
     assert_eq!(checks["animations"], 1);
     // The bent joint's blend zone looks different under dual quaternions.
@@ -196,11 +158,7 @@ fn cesiumman_with_a_report_shows_cuts_tables_and_warnings() {
         "warnings": ["</script><b>not markup</b>"],
         "vertices": 3273,
     });
-    let checks = check_in_browser(
-        "cesiumman_report",
-        &model("cesiumman/CesiumMan.glb"),
-        Some(&report),
-    );
+    let checks = check_in_browser("cesiumman_report", &CESIUMMAN.input_path(), Some(&report));
     assert_eq!(checks["curve_segments"], 16 + 48);
     // Joints, regions, timings and counts; each with a header row.
     assert_eq!(checks["report_tables"], 4);
@@ -209,11 +167,7 @@ fn cesiumman_with_a_report_shows_cuts_tables_and_warnings() {
 
 #[test]
 fn riggedfigure_opens_and_poses() {
-    let checks = check_in_browser(
-        "riggedfigure",
-        &model("riggedfigure/RiggedFigure.glb"),
-        None,
-    );
+    let checks = check_in_browser("riggedfigure", &RIGGEDFIGURE.input_path(), None);
     assert_gpu_skinning_matches_reference(&checks);
     assert_eq!(checks["animations"], 1);
 }
@@ -336,8 +290,7 @@ fn the_demo_character_skinned_by_the_project_shows_its_cuts_and_plays_a_bvh_moti
     assert_eq!(checks["report_tables"], 4);
     assert_gpu_skinning_matches_reference(&checks);
 
-    let walk = Path::new(DATA).join("motion/walk.bvh");
-    assert!(walk.is_file(), "missing test data: {}", walk.display());
+    let walk = motion_path("walk.bvh");
     let animated = dir.join("demo_walk.html");
     atlas_skin(&[
         "report".as_ref(),
@@ -357,20 +310,15 @@ fn the_demo_character_skinned_by_the_project_shows_its_cuts_and_plays_a_bvh_moti
 fn makehuman_skinned_by_the_project_opens_with_its_163_joints() {
     let dir = output_dir();
     let [glb, html] = ["makehuman.glb", "makehuman.html"].map(|f| dir.join(f));
-    let mesh = model("makehuman/base.obj");
-    let skeleton = model("makehuman/default.mhskel");
-    atlas_skin(&[
-        "skin".as_ref(),
-        mesh.as_os_str(),
-        "--skeleton".as_ref(),
-        skeleton.as_os_str(),
-        "--group".as_ref(),
-        "body".as_ref(),
-        "-o".as_ref(),
-        glb.as_os_str(),
-        "--html".as_ref(),
-        html.as_os_str(),
+    let mut args: Vec<OsString> = vec!["skin".into()];
+    args.extend(MAKEHUMAN.input_args(false));
+    args.extend([
+        "-o".into(),
+        glb.into(),
+        "--html".into(),
+        html.clone().into(),
     ]);
+    atlas_skin(&args);
     let checks = drive("makehuman", &html);
     assert!(checks["curve_segments"].as_u64() > Some(0), "{checks:#}");
     assert_gpu_skinning_matches_reference(&checks);

@@ -1,34 +1,32 @@
 //! `atlas-skin report`: what the HTML file holds and how bad input is refused.
 
+mod support;
+
+use atlas_skin_corpus::{motion_path, CESIUMMAN};
 use base64::Engine;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data");
+use std::process::Output;
+use support::{atlas_skin, out_dir};
 
 fn cesiumman() -> PathBuf {
-    let path = Path::new(DATA).join("models/cesiumman/CesiumMan.glb");
-    assert!(path.is_file(), "missing test data: {}", path.display());
-    path
+    CESIUMMAN.input_path()
 }
 
 /// A fresh scratch folder for one test.
 fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("report_cli")
-        .join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    out_dir(&format!("report_cli/{name}"))
 }
 
+/// `atlas-skin report ARGS...`.
 fn report(args: &[&Path]) -> Output {
-    let mut command = Command::new(env!("CARGO_BIN_EXE_atlas-skin"));
-    command.arg("report");
-    for arg in args {
-        command.arg(arg);
-    }
-    command.output().unwrap()
+    let mut all = vec![Path::new("report")];
+    all.extend_from_slice(args);
+    atlas_skin(&all)
+}
+
+/// `atlas-skin report CesiumMan.glb FLAG FILE -o OUT`.
+fn report_cesiumman_with(flag: &str, file: &Path, out: &Path) -> Output {
+    report(&[&cesiumman(), Path::new(flag), file, Path::new("-o"), out])
 }
 
 /// The text content of the `<script ... id="ID">` element of `page`.
@@ -52,13 +50,7 @@ fn the_page_embeds_the_model_and_the_report_intact() {
     let report_path = dir.join("r.json");
     std::fs::write(&report_path, report_json.to_string()).unwrap();
     let out = dir.join("cesiumman.html");
-    let output = report(&[
-        &cesiumman(),
-        Path::new("--report"),
-        &report_path,
-        Path::new("-o"),
-        &out,
-    ]);
+    let output = report_cesiumman_with("--report", &report_path, &out);
     assert!(
         output.status.success(),
         "{}",
@@ -107,13 +99,7 @@ fn an_invalid_report_json_is_refused() {
     let report_path = dir.join("r.json");
     std::fs::write(&report_path, "{ not json").unwrap();
     let out = dir.join("r.html");
-    let output = report(&[
-        &cesiumman(),
-        Path::new("--report"),
-        &report_path,
-        Path::new("-o"),
-        &out,
-    ]);
+    let output = report_cesiumman_with("--report", &report_path, &out);
     assert!(!output.status.success());
     assert!(String::from_utf8_lossy(&output.stderr).contains("is not valid JSON"));
     assert!(!out.exists());
@@ -136,17 +122,10 @@ fn the_report_never_replaces_its_input() {
 #[test]
 fn a_motion_whose_joints_match_none_of_the_character_is_refused() {
     let dir = scratch("bvh_mismatch");
-    let walk = Path::new(DATA).join("motion/walk.bvh");
-    assert!(walk.is_file(), "missing test data: {}", walk.display());
+    let walk = motion_path("walk.bvh");
     let out = dir.join("r.html");
     // CesiumMan's joints carry no names, so no BVH joint maps onto them.
-    let output = report(&[
-        &cesiumman(),
-        Path::new("--bvh"),
-        &walk,
-        Path::new("-o"),
-        &out,
-    ]);
+    let output = report_cesiumman_with("--bvh", &walk, &out);
     assert!(!output.status.success());
     assert!(String::from_utf8_lossy(&output.stderr).contains("putting the motion"));
     assert!(!out.exists());

@@ -2,38 +2,20 @@
 //! (tests/js/three_anim.mjs) on the corpus glTF models: every node's local translation,
 //! rotation and scale at several times.
 
+use atlas_skin_corpus::{node_json, CESIUMMAN, RIGGEDFIGURE, RIGGEDSIMPLE};
 use atlas_skin_runtime::Trs;
 use glam::{Quat, Vec3};
+use std::ffi::OsString;
 use std::path::Path;
-use std::process::Command;
-
-const MODELS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/models");
-const WORKSPACE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
 
 /// Times as fractions of the clip: first key, between keys, near the end.
 const FRACTIONS: [f32; 5] = [0.0, 0.13, 0.5, 0.71, 0.98];
 
+/// Every node's local transform at `times` of animation 0 of `input`, sampled by three.js.
 fn three_frames(input: &Path, times: &[f32]) -> serde_json::Value {
-    assert!(
-        Path::new(WORKSPACE)
-            .join("tests/js/node_modules/three")
-            .exists(),
-        "tests/js/node_modules is missing: run scripts/install-test-deps"
-    );
-    let output = Command::new("node")
-        .current_dir(WORKSPACE)
-        .arg("tests/js/three_anim.mjs")
-        .arg(input)
-        .arg("0")
-        .args(times.iter().map(|t| t.to_string()))
-        .output()
-        .expect("run node (install it with scripts/install-test-deps)");
-    assert!(
-        output.status.success(),
-        "three_anim.mjs failed: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    serde_json::from_slice(&output.stdout).expect("JSON")
+    let mut args: Vec<OsString> = vec![input.into(), "0".into()];
+    args.extend(times.iter().map(|t| t.to_string().into()));
+    node_json("three_anim.mjs", &args)
 }
 
 fn floats<const N: usize>(value: &serde_json::Value) -> [f32; N] {
@@ -43,13 +25,8 @@ fn floats<const N: usize>(value: &serde_json::Value) -> [f32; N] {
 
 #[test]
 fn sampling_matches_three_js_animation_mixer() {
-    for (folder, file) in [
-        ("cesiumman", "CesiumMan.glb"),
-        ("riggedfigure", "RiggedFigure.glb"),
-        ("riggedsimple", "RiggedSimple.glb"),
-    ] {
-        let input = Path::new(MODELS).join(folder).join(file);
-        assert!(input.exists(), "corpus file {} is missing", input.display());
+    for model in [CESIUMMAN, RIGGEDFIGURE, RIGGEDSIMPLE] {
+        let (folder, input) = (model.name, model.input_path());
         let character = atlas_skin_io::load_character(&input, &Default::default()).expect("load");
         let rig = character.rig.as_ref().expect("rig");
         let clip = character.clips.first().expect("an animation");

@@ -2,54 +2,26 @@
 //! GLTFLoader + SkinnedMesh.getVertexPosition) on the corpus glTF models, for animation
 //! frames and for a pose file, within 1e-5 of the bounding-box diagonal.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod support;
 
-const MODELS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/models");
-const WORKSPACE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
+use atlas_skin_corpus::{node_json, Model, CESIUMMAN, RIGGEDFIGURE, RIGGEDSIMPLE};
+use std::ffi::OsStr;
+use std::path::Path;
+use support::{atlas_skin_ok, out_dir};
 
-/// (folder, file, joints turned by the pose file)
-const CORPUS: [(&str, &str, &[&str]); 3] = [
-    (
-        "cesiumman",
-        "CesiumMan.glb",
-        &["node3", "node11", "node16", "node8"],
-    ),
-    (
-        "riggedfigure",
-        "RiggedFigure.glb",
-        &["node3", "node11", "node16", "node8"],
-    ),
-    ("riggedsimple", "RiggedSimple.glb", &["node2", "node3"]),
+/// (model, joints turned by the pose file)
+const CORPUS: [(Model, &[&str]); 3] = [
+    (CESIUMMAN, &["node3", "node11", "node16", "node8"]),
+    (RIGGEDFIGURE, &["node3", "node11", "node16", "node8"]),
+    (RIGGEDSIMPLE, &["node2", "node3"]),
 ];
-
-fn model(folder: &str, file: &str) -> PathBuf {
-    let path = Path::new(MODELS).join(folder).join(file);
-    assert!(path.exists(), "corpus file {} is missing", path.display());
-    path
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("atlas-skin-three-pose-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temporary directory");
-    dir.join(name)
-}
 
 /// Vertex positions of `atlas-skin pose INPUT ARGS -o OUT.obj`.
 fn atlas_pose(input: &Path, args: &[&str], out: &Path) -> Vec<[f64; 3]> {
-    let output = Command::new(env!("CARGO_BIN_EXE_atlas-skin"))
-        .arg("pose")
-        .arg(input)
-        .args(args)
-        .arg("-o")
-        .arg(out)
-        .output()
-        .expect("run atlas-skin");
-    assert!(
-        output.status.success(),
-        "atlas-skin pose failed: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
+    let mut all = vec![OsStr::new("pose"), input.as_os_str()];
+    all.extend(args.iter().map(OsStr::new));
+    all.extend([OsStr::new("-o"), out.as_os_str()]);
+    atlas_skin_ok(&all);
     let text = std::fs::read_to_string(out).expect("pose wrote the OBJ");
     text.lines()
         .filter_map(|l| l.strip_prefix("v "))
@@ -65,25 +37,9 @@ fn atlas_pose(input: &Path, args: &[&str], out: &Path) -> Vec<[f64; 3]> {
 
 /// Vertex positions three.js computes for the same input and pose.
 fn three_pose(input: &Path, args: &[&str]) -> Vec<[f64; 3]> {
-    let modules = Path::new(WORKSPACE).join("tests/js/node_modules/three");
-    assert!(
-        modules.exists(),
-        "{} is missing: run scripts/install-test-deps",
-        modules.display()
-    );
-    let output = Command::new("node")
-        .current_dir(WORKSPACE)
-        .arg("tests/js/three_pose.mjs")
-        .arg(input)
-        .args(args)
-        .output()
-        .expect("run node (install it with scripts/install-test-deps)");
-    assert!(
-        output.status.success(),
-        "three_pose.mjs failed: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    let json: serde_json::Value = serde_json::from_slice(&output.stdout).expect("JSON");
+    let mut all = vec![input.as_os_str()];
+    all.extend(args.iter().map(OsStr::new));
+    let json = node_json("three_pose.mjs", &all);
     let flat: Vec<f64> = json["positions"]
         .as_array()
         .expect("positions")
@@ -117,10 +73,11 @@ fn assert_agree(what: &str, ours: &[[f64; 3]], theirs: &[[f64; 3]]) {
 
 #[test]
 fn animation_frames_agree_with_three_js() {
-    for (folder, file, _) in CORPUS {
-        let input = model(folder, file);
+    let dir = out_dir("three_pose_anim");
+    for (model, _) in CORPUS {
+        let (folder, input) = (model.name, model.input_path());
         for time in ["0.3", "0.95"] {
-            let out = scratch(&format!("{folder}-anim-{time}.obj"));
+            let out = dir.join(format!("{folder}-anim-{time}.obj"));
             let ours = atlas_pose(&input, &["--anim", "0", "--time", time], &out);
             let theirs = three_pose(&input, &["--anim", "0", "--time", time]);
             assert_agree(&format!("{folder} at {time} s"), &ours, &theirs);
@@ -130,8 +87,9 @@ fn animation_frames_agree_with_three_js() {
 
 #[test]
 fn pose_files_agree_with_three_js() {
-    for (folder, file, joints) in CORPUS {
-        let input = model(folder, file);
+    let dir = out_dir("three_pose_file");
+    for (model, joints) in CORPUS {
+        let (folder, input) = (model.name, model.input_path());
         // Unit quaternions of 30° to 50° about assorted axes.
         let rotations = [
             [0.2588, 0.0, 0.0, 0.9659],
@@ -144,10 +102,10 @@ fn pose_files_agree_with_three_js() {
             .zip(rotations)
             .map(|(name, q)| (name.to_string(), serde_json::json!(q)))
             .collect();
-        let pose_path = scratch(&format!("{folder}-pose.json"));
+        let pose_path = dir.join(format!("{folder}-pose.json"));
         std::fs::write(&pose_path, serde_json::Value::Object(pose).to_string()).unwrap();
         let pose_arg = pose_path.to_str().expect("UTF-8 path");
-        let out = scratch(&format!("{folder}-pose.obj"));
+        let out = dir.join(format!("{folder}-pose.obj"));
         let ours = atlas_pose(&input, &["--pose", pose_arg], &out);
         let theirs = three_pose(&input, &["--pose", pose_arg]);
         assert_agree(&format!("{folder} pose file"), &ours, &theirs);

@@ -1,43 +1,20 @@
 //! The non-glTF readers on the real corpus (../shared/data): counts, joint names, joint
 //! positions and reference weights against each model's manifest.json.
 
-use atlas_skin_io::{bvh, load_character, Character, LoadOptions};
+use atlas_skin_corpus::{motion_path, Model, ARM, ELEPHANT, HAND, MAKEHUMAN};
+use atlas_skin_io::{bvh, load_character, Character};
 use serde_json::Value;
-use std::path::{Path, PathBuf};
 
-const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data");
-
-fn data(relative: &str) -> PathBuf {
-    let path = Path::new(DATA).join(relative);
-    assert!(path.exists(), "corpus file {} is missing", path.display());
-    path
-}
-
-fn manifest(model: &str) -> Value {
-    let text = std::fs::read_to_string(data(&format!("models/{model}/manifest.json"))).unwrap();
-    serde_json::from_str(&text).unwrap()
-}
-
-fn load(
-    model: &str,
-    mesh: &str,
-    skeleton: &str,
-    weights: Option<&str>,
-    group: Option<&str>,
-) -> Character {
-    let dir = format!("models/{model}/");
-    let options = LoadOptions {
-        skeleton: Some(data(&(dir.clone() + skeleton))),
-        group: group.map(str::to_string),
-        weights: weights.map(|w| data(&(dir.clone() + w))),
-    };
-    load_character(&data(&(dir + mesh)), &options).unwrap_or_else(|e| panic!("{e}"))
+/// The model's input with its skeleton and reference weights.
+fn load(model: &Model) -> Character {
+    load_character(&model.input_path(), &model.load_options(true)).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Stored vertex and triangle counts, joint names, parents and bind positions (to 1e-5 of
 /// the manifest's 6 decimals, relative to the model's size).
-fn check_against_manifest(model: &str, character: &Character) {
-    let m = manifest(model);
+fn check_against_manifest(model: &Model, character: &Character) {
+    let m = model.manifest();
+    let model = model.name;
     assert_eq!(
         character.mesh.positions.len() as u64,
         m["stored_vertex_count"].as_u64().unwrap()
@@ -98,8 +75,8 @@ fn check_row_sums(character: &Character, tolerance: f32) {
 
 #[test]
 fn arm_obj_tgf_and_per_bone_dmat() {
-    let arm = load("arm", "arm.obj", "arm.tgf", Some("arm-weights.dmat"), None);
-    check_against_manifest("arm", &arm);
+    let arm = load(&ARM);
+    check_against_manifest(&ARM, &arm);
     check_row_sums(&arm, 1e-5);
     // 4 bone columns land on joints tgf_1..tgf_4; the tip joint tgf_5 has no bone of its own.
     let weights = arm.reference_weights.as_ref().unwrap();
@@ -108,21 +85,15 @@ fn arm_obj_tgf_and_per_bone_dmat() {
 
 #[test]
 fn elephant_obj_tgf_and_binary_dmat() {
-    let elephant = load(
-        "elephant",
-        "elephant.obj",
-        "elephant.tgf",
-        Some("elephant-weights.dmat"),
-        None,
-    );
-    check_against_manifest("elephant", &elephant);
+    let elephant = load(&ELEPHANT);
+    check_against_manifest(&ELEPHANT, &elephant);
     check_row_sums(&elephant, 1e-5);
 }
 
 #[test]
 fn hand_tetrahedral_mesh_keeps_the_surface() {
-    let hand = load("hand", "hand.mesh", "hand.tgf", None, None);
-    check_against_manifest("hand", &hand);
+    let hand = load(&HAND);
+    check_against_manifest(&HAND, &hand);
     assert_eq!(hand.file_vertex.len(), 4780);
     assert!(
         hand.warnings
@@ -135,14 +106,8 @@ fn hand_tetrahedral_mesh_keeps_the_surface() {
 
 #[test]
 fn makehuman_body_group_mhskel_and_mhw() {
-    let human = load(
-        "makehuman",
-        "base.obj",
-        "default.mhskel",
-        Some("default_weights.mhw"),
-        Some("body"),
-    );
-    check_against_manifest("makehuman", &human);
+    let human = load(&MAKEHUMAN);
+    check_against_manifest(&MAKEHUMAN, &human);
     // MakeHuman rounds weights to 3 decimals: sums range 0.954–1.063 (manifest).
     check_row_sums(&human, 0.07);
     assert_eq!(*human.file_vertex.last().unwrap(), 13379);
@@ -150,11 +115,11 @@ fn makehuman_body_group_mhskel_and_mhw() {
 
 #[test]
 fn bvh_clips_match_the_motion_manifest() {
-    let text = std::fs::read_to_string(data("motion/manifest.json")).unwrap();
+    let text = std::fs::read_to_string(motion_path("manifest.json")).unwrap();
     let manifest: Value = serde_json::from_str(&text).unwrap();
     for clip in manifest["clips"].as_array().unwrap() {
         let file = clip["file"].as_str().unwrap();
-        let (skeleton, rig, motion) = bvh::read_motion(&data(&format!("motion/{file}"))).unwrap();
+        let (skeleton, rig, motion) = bvh::read_motion(&motion_path(file)).unwrap();
         let names: Vec<&str> = clip["joint_names"]
             .as_array()
             .unwrap()

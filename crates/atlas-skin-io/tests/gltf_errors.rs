@@ -73,6 +73,18 @@ fn broken_files() -> Vec<(&'static str, Vec<u8>, Kind, &'static str)> {
     let mut nan_position = buffer0.clone();
     // POSITION is bufferView 1 (byte 48 of buffer 0): vertex 2's x.
     nan_position[48 + 24..48 + 28].copy_from_slice(&f32::NAN.to_le_bytes());
+    let mut nan_y = buffer0.clone();
+    // Vertex 1 is (1, 0, 0): its y.
+    nan_y[48 + 16..48 + 20].copy_from_slice(&f32::NAN.to_le_bytes());
+    let mut unskinned = skin_json.clone();
+    unskinned.as_object_mut().unwrap().remove("skins");
+    unskinned["nodes"][0]
+        .as_object_mut()
+        .unwrap()
+        .remove("skin");
+    let mut huge_scale = unskinned.clone();
+    // Vertex 6 is (0, 1.5, 0): 1.5 × 3e38 overflows float32.
+    huge_scale["nodes"][0]["scale"] = json!([3e38, 3e38, 3e38]);
     let mut bad_index = buffer0.clone();
     bad_index[2..4].copy_from_slice(&99u16.to_le_bytes());
     vec![
@@ -137,6 +149,18 @@ fn broken_files() -> Vec<(&'static str, Vec<u8>, Kind, &'static str)> {
             with_buffer0(skin_json.clone(), &nan_position),
             Kind::Invalid,
             "vertex 2 is not finite",
+        ),
+        (
+            "nan_unskinned.gltf",
+            with_buffer0(unskinned, &nan_y),
+            Kind::Invalid,
+            "vertex 1 is not finite: [1, NaN, 0]",
+        ),
+        (
+            "overflow.gltf",
+            huge_scale.to_string().into_bytes(),
+            Kind::Invalid,
+            "vertex 6 [0, 1.5, 0] is not finite after its node's world transform: [0, inf, 0]",
         ),
         (
             "index.gltf",

@@ -167,3 +167,54 @@ fn unskinned_documents_apply_node_transforms_and_convert_strips() {
     assert_eq!(character.mesh.positions[3], Vec3::new(2.0, 2.0, 5.0));
     assert_eq!(character.warnings.len(), 1, "{:?}", character.warnings);
 }
+
+/// The UTF-8 byte-order mark glTF forbids but some exporters write before the JSON (of a
+/// `.gltf`, or of a `.glb`'s JSON chunk): the file reads like the one without it, with a
+/// warning that names the mark.
+#[test]
+fn a_byte_order_mark_is_accepted_with_a_warning() {
+    const BOM: &[u8] = b"\xEF\xBB\xBF";
+    let dir = out_dir("byte_order_mark");
+    let text_path = model_path("simpleskin", "SimpleSkin.gltf");
+    let text_with_mark = dir.join("SimpleSkin.gltf");
+    std::fs::write(
+        &text_with_mark,
+        [BOM, &std::fs::read(&text_path).unwrap()].concat(),
+    )
+    .unwrap();
+
+    let glb_path = model_path("riggedsimple", "RiggedSimple.glb");
+    let glb = std::fs::read(&glb_path).unwrap();
+    let json_length = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    // The chunk again: the mark, the JSON without its padding, padding to 4 bytes.
+    let json = glb[20..20 + json_length].trim_ascii_end();
+    let mut chunk = [BOM, json].concat();
+    chunk.resize(chunk.len().next_multiple_of(4), b' ');
+    let rest = &glb[20 + json_length..];
+    let total = (20 + chunk.len() + rest.len()) as u32;
+    let binary_with_mark = dir.join("RiggedSimple.glb");
+    std::fs::write(
+        &binary_with_mark,
+        [
+            &glb[..8],
+            &total.to_le_bytes(),
+            &(chunk.len() as u32).to_le_bytes(),
+            &glb[16..20],
+            &chunk,
+            rest,
+        ]
+        .concat(),
+    )
+    .unwrap();
+
+    for (plain, marked) in [(text_path, text_with_mark), (glb_path, binary_with_mark)] {
+        let plain = gltf::read(&plain).unwrap();
+        let marked = gltf::read(&marked).unwrap();
+        assert_eq!(plain.mesh, marked.mesh);
+        assert_eq!(plain.skeleton, marked.skeleton);
+        assert_eq!(plain.reference_weights, marked.reference_weights);
+        let mentions_mark = |w: &Vec<String>| w.iter().any(|w| w.contains("byte-order mark"));
+        assert!(!mentions_mark(&plain.warnings));
+        assert!(mentions_mark(&marked.warnings), "{:?}", marked.warnings);
+    }
+}

@@ -306,6 +306,12 @@ fn portable_kernel<B: Blend>(k: usize, normals: bool, tangents: bool) -> Kernel<
 
 /// Halves the span until it has at most [`PARALLEL_CHUNK`] vertices, running the halves
 /// with `rayon::join` (work stealing balances the chunks; nothing is allocated).
+///
+/// This is what `par_chunks_mut` over vertex chunks does inside rayon (its producers split
+/// in halves and join), written out because a span is up to eight slices of different
+/// strides (K joints and K − 1 weights per vertex) of which the normal and tangent
+/// streams may be empty, and a zip of `par_chunks_mut` stops at its shortest input (an
+/// empty stream has no chunk): zipping would need one loop per set of present streams.
 fn run_parallel<B: Blend>(palette: &[B], k: usize, span: Span, kernel: Kernel<B>) {
     if span.len() <= PARALLEL_CHUNK {
         kernel(palette, k, span);

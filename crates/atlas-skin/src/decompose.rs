@@ -6,15 +6,17 @@
 //! Conflict rule. Two curves conflict when they cross or touch: they run through a common
 //! vertex, or two of their chords in one face interleave or end within `snap_fraction` of
 //! each other along the face's boundary. Curves that merely pass through the same faces
-//! (parallel chords of a coarse mesh's large triangles) do not conflict. Joints are placed in increasing order of their best perimeter, so the small
-//! cross-sections of fingers, toes and distal limbs are placed before the palm, leg-root,
-//! neck and torso planes that would cross them. A joint whose best curve conflicts with an
-//! already placed one tries its next-best closed sections (the other sampled planes, by
-//! increasing perimeter); when none fits, it gets a soft boundary: its plane restricted to
-//! the region that holds it (METHOD.md, "extensions"), which the weights stage blends
-//! across. A joint is left without a boundary only for the reasons of
-//! [`crate::joint_roles`], or when no region holds it (an empty surface); the report says
-//! which.
+//! (parallel chords of a coarse mesh's large triangles) do not conflict. Joints are placed
+//! in increasing order of their best perimeter, so the small cross-sections of fingers,
+//! toes and distal limbs are placed before the palm, leg-root, neck and torso planes that
+//! would cross them; branching joints on the mirror plane (a spine joint where the legs or
+//! the arms branch) come after all others, whatever their perimeter. A joint whose best
+//! curve conflicts with an already placed one tries its next-best closed sections (the
+//! other sampled planes, by increasing perimeter); when none fits, it gets a soft boundary:
+//! its plane restricted to the region that holds it (METHOD.md, "extensions"), which the
+//! weights stage blends across; so does a joint that [`crate::joint_roles`] allows no cut.
+//! A joint is left without a boundary only for the reasons of [`crate::joint_roles`], or
+//! when no region holds it (an empty surface); the report says which.
 
 use crate::cut::{find_cut_candidates, CutCandidate, CutSearch, CutSurface};
 use crate::joint_roles::{plan_joints, JointFrame, JointPlan, Override};
@@ -306,7 +308,7 @@ fn search_all_cuts(
         .par_iter()
         .enumerate()
         .map(|(j, plan)| match plan {
-            JointPlan::Boundary(frame) => {
+            JointPlan::Boundary(frame) | JointPlan::Soft(frame, _) => {
                 let other_bones: Vec<[DVec3; 2]> = bones
                     .iter()
                     .filter(|&&(p, c)| p != j && c != j)
@@ -362,13 +364,17 @@ fn place_cuts(
     gap: f64,
 ) -> Vec<Placement> {
     let candidates: Vec<&[CutCandidate]> = searches.iter().map(|s| &s.candidates[..]).collect();
+    let on_mirror_plane =
+        |j: usize| matches!(&plans[j], JointPlan::Boundary(frame) if frame.on_mirror_plane);
     let mut order: Vec<usize> = (0..plans.len())
-        .filter(|&j| !candidates[j].is_empty())
+        .filter(|&j| matches!(plans[j], JointPlan::Boundary(_)) && !candidates[j].is_empty())
         .collect();
     order.sort_by(|&a, &b| {
-        candidates[a][0]
-            .perimeter
-            .total_cmp(&candidates[b][0].perimeter)
+        on_mirror_plane(a).cmp(&on_mirror_plane(b)).then(
+            candidates[a][0]
+                .perimeter
+                .total_cmp(&candidates[b][0].perimeter),
+        )
     });
     let mut placed_chords: HashMap<u32, Vec<(u32, Chord)>> = HashMap::new();
     let mut vertex_owner: HashMap<u32, u32> = HashMap::new();
@@ -412,6 +418,12 @@ fn place_cuts(
         .map(|((plan, placed), search)| {
             let frame = match plan {
                 JointPlan::Skip(reason) => return Placement::Skip(reason.clone()),
+                JointPlan::Soft(frame, reason) => {
+                    return Placement::Soft {
+                        reason: reason.clone(),
+                        frame: *frame,
+                    }
+                }
                 JointPlan::Boundary(frame) => *frame,
             };
             let reason = match placed {

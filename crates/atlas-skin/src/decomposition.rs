@@ -75,8 +75,9 @@ pub enum JointStatus {
     Cut,
     /// A soft boundary, with why no cut was placed.
     Soft(String),
-    /// No boundary, with why (branching joint on the symmetry axis, end site, outside the
-    /// mesh and owning no geometry, forbidden by the user, ...).
+    /// No boundary, with why (root, end site, branching joint on the mirror plane at the
+    /// junction of its branches or at the skin, outside the mesh and owning no geometry,
+    /// forbidden by the user, ...).
     Skipped(String),
 }
 

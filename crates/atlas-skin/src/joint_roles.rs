@@ -4,21 +4,36 @@
 //! 1. Forbidden by the user: no boundary. Forced by the user: a boundary, whatever follows.
 //! 2. A root has no upper bone to cut: its region is the root region. A joint whose bones
 //!    all have zero length has no direction to cut across: no boundary.
-//! 3. A branching joint (two or more children) on the skeleton's mirror plane (pelvis,
-//!    chest) has no boundary, as in the paper. Off the plane (a clavicle with a breast bone,
-//!    a wrist with five finger bones) it is cut like a chain joint whose lower bone is the
-//!    mean of its unit child directions — for a wrist, the average finger direction.
-//! 4. A joint lies outside the mesh and owns no geometry when it is farther from the
+//! 3. A joint lies outside the mesh and owns no geometry when it is farther from the
 //!    surface than `outside_ratio` × its longest bone and outside it: most of six rays from
 //!    it (±x, ±y, ±z, slightly turned) first meet the surface from outside, or not at all.
 //!    Then: no boundary. A joint near the surface (a face bone in an eye socket) keeps its
 //!    boundary: the skin around it is its to move. A winding number is not used: it fails
 //!    on open and multi-piece meshes; the ray vote needs only a locally outward surface.
-//! 5. A leaf owns geometry when its parent's bone runs on into the mesh: the ray from p_J
-//!    along the upper bone leaves the surface from inside (hit face normal along the ray on
-//!    an outward-oriented surface) at a distance ≥ `leaf_extent_ratio` × the joint's
-//!    surface distance. It is then cut with lower bone = upper bone. Otherwise it is an end
-//!    site: no boundary.
+//! 4. A branching joint (two or more children) on the skeleton's mirror plane (pelvis,
+//!    chest, head, jaw). The paper gives it no boundary; here (METHOD.md, "extensions") it
+//!    gets one when it owns a part of the trunk. Nearer to the surface than a quarter of its
+//!    shortest bone (a jaw or tongue root in the mouth) it lies at the skin, not in a trunk:
+//!    no boundary (a soft plane there reaches down the front of the neck: METHOD.md's
+//!    bleeding face bones). Otherwise where its branches start is judged against its
+//!    section's diameter D = 2 × surface distance. Most child bones (the median) shorter
+//!    than D: it sits at the junction, its children's boundaries enclose all around it, it
+//!    owns no geometry: no boundary. Some child bone shorter than D: any plane through it
+//!    slices that branch's root: a soft boundary only. Otherwise its cut is searched like
+//!    any other but placed after all others ([`JointFrame::on_mirror_plane`]), and it is
+//!    soft when no clean cut fits.
+//!    Off the plane (a clavicle with a breast bone, a wrist with five finger bones) a
+//!    branching joint is cut like a chain joint whose lower bone is the mean of its unit
+//!    child directions — for a wrist, the average finger direction.
+//! 5. A leaf owns geometry when the surface runs on past it. Either test suffices:
+//!    (a) the ray from p_J along the upper bone u leaves the surface from inside (hit face
+//!    normal along the ray on an outward-oriented surface) at a distance ≥
+//!    `leaf_extent_ratio` × r, r the joint's surface distance; (b) for a joint inside the
+//!    body (r ≥ a tenth of its bone), the part of the surface nearest to it — vertices v past
+//!    it within 60° of u, (v − p_J) · u ≥ ½ |v − p_J|, nearer to p_J than to every bone not
+//!    at J — reaches farther than 2 r from p_J. (b) finds toes beyond the ball of a foot, which (a) misses when the foot
+//!    bone points down into the sole. It is then cut with lower bone = upper bone.
+//!    Otherwise it is an end site (a fingertip cap reaches about 1.4–1.7 r): no boundary.
 //! 6. Twist and helper joints on a straight bone are chain joints with collinear bones: they
 //!    are cut perpendicular to the bone (the cone search), and the weights stage blends the
 //!    regions of one limb; nothing tells them apart from a straight elbow geometrically.
@@ -58,6 +73,9 @@ pub struct JointFrame {
     pub bone_length: f64,
     /// Distance from p_J to the nearest surface point.
     pub surface_distance: f64,
+    /// A branching joint on the skeleton's mirror plane (pelvis, chest, head): its plane
+    /// crosses the trunk where limbs branch, so it is placed after every other cut.
+    pub on_mirror_plane: bool,
 }
 
 /// What the decomposition does at one joint.
@@ -65,6 +83,8 @@ pub struct JointFrame {
 pub enum JointPlan {
     /// Search a cut (and fall back to a soft boundary).
     Boundary(JointFrame),
+    /// A soft boundary only, never a cut, with the reason for the report.
+    Soft(JointFrame, String),
     /// No boundary, with the reason for the report.
     Skip(String),
 }
@@ -81,13 +101,23 @@ pub enum Override {
 /// few percent of the skeleton's size off it.
 const ON_PLANE: f64 = 0.25;
 
-/// Rule 5's second test: the part of the surface nearest to a leaf owns geometry when it
-/// reaches this many times the joint's surface distance past it (a toe beyond the ball of a
-/// foot reaches 2–7 times; a fingertip cap around an end site about 1.4–1.7 times).
+/// Rule 5 (b): the part of the surface nearest to a leaf owns geometry when it reaches this
+/// many times the joint's surface distance past it (a toe beyond the ball of a foot reaches
+/// 2–7 times; a fingertip cap around an end site about 1.4–1.7 times).
 const LEAF_REACH_RATIO: f64 = 2.0;
 
-/// A joint nearer to the surface than this fraction of its bone lies in the skin (a face
-/// bone): the part nearest to it is a patch of skin, not a part of the body past it.
+/// Rule 4: a branching joint on the mirror plane lies in a trunk when its surface distance
+/// is at least this fraction of its shortest bone.
+const TRUNK_DEPTH: f64 = 0.25;
+
+/// Rule 5 (b) counts the vertices within 60° of the leaf's bone (cos 60° = ½): toes turn
+/// about 45° from a foot bone, while the rim of a broad flat end (a pad under an end site)
+/// lies across it.
+const PAST_COSINE: f64 = 0.5;
+
+/// Rule 5 (b) applies to a joint at least this fraction of its bone from the surface; one
+/// nearer lies in the skin (a face bone): the part nearest to it is a patch of skin, not a
+/// part of the body past it.
 const INTERIOR_RADIUS: f64 = 0.1;
 
 /// Bones shorter than this fraction of the skeleton's diagonal have no direction.
@@ -143,7 +173,13 @@ pub fn plan_joints(
                 .chain(child_vectors.iter().map(|v| v.length()))
                 .fold(0.0, f64::max);
             let surface_distance = spheres.nearest_distance(mesh, p);
+            let on_mirror_plane = child_vectors.len() >= 2
+                && symmetry.is_some_and(|plane| {
+                    (plane.normal.dot(p) - plane.offset).abs()
+                        <= ON_PLANE * params.symmetry_tolerance * scale
+                });
             let frame = JointFrame {
+                on_mirror_plane,
                 position: p,
                 upper,
                 lower,
@@ -153,17 +189,6 @@ pub fn plan_joints(
             if forced {
                 return JointPlan::Boundary(frame);
             }
-            if children[j].len() >= 2 {
-                if let Some(plane) = &symmetry {
-                    let off = (plane.normal.dot(p) - plane.offset).abs();
-                    if off <= ON_PLANE * params.symmetry_tolerance * scale {
-                        return JointPlan::Skip(format!(
-                            "branching joint on the mirror plane ({} children)",
-                            children[j].len()
-                        ));
-                    }
-                }
-            }
             if surface_distance > params.outside_ratio * longest_bone
                 && !is_inside_by_rays(mesh, spheres, p, orientation)
             {
@@ -172,51 +197,90 @@ pub fn plan_joints(
                      away, longest bone {longest_bone:.4}"
                 ));
             }
-            if children[j].is_empty() && !leaf_owns_geometry(mesh, spheres, skeleton, positions, j, &frame, orientation, params) {
-                return JointPlan::Skip(
-                    "end site: the surface does not run on past the joint".into(),
+            if on_mirror_plane {
+                let mut child_lengths: Vec<f64> =
+                    child_vectors.iter().map(|v| v.length()).collect();
+                child_lengths.sort_unstable_by(f64::total_cmp);
+                let section_diameter = 2.0 * surface_distance;
+                if surface_distance < TRUNK_DEPTH * bone_length {
+                    return JointPlan::Skip(format!(
+                        "branching joint on the mirror plane near the skin, not in a trunk: \
+                         surface {surface_distance:.4} away, shortest bone {bone_length:.4}"
+                    ));
+                }
+                if child_lengths[child_lengths.len() / 2] < section_diameter {
+                    return JointPlan::Skip(format!(
+                        "branching joint on the mirror plane at the junction of its branches: \
+                         most of them start within its cross-section (median child bone \
+                         {:.4}, section diameter about {section_diameter:.4})",
+                        child_lengths[child_lengths.len() / 2]
+                    ));
+                }
+                if child_lengths[0] < section_diameter {
+                    return JointPlan::Soft(
+                        frame,
+                        format!(
+                            "branching joint on the mirror plane with a branch starting within \
+                             its cross-section (child bone {:.4}, section diameter about \
+                             {section_diameter:.4}): a plane there would cut across it",
+                            child_lengths[0]
+                        ),
+                    );
+                }
+            }
+            if children[j].is_empty() {
+                let other_bones: Vec<[DVec3; 2]> = (0..skeleton.len())
+                    .filter_map(|c| skeleton.parent(c).map(|q| (q, c)))
+                    .filter(|&(q, c)| q != j && c != j)
+                    .map(|(q, c)| [positions[q], positions[c]])
+                    .collect();
+                let owns = leaf_owns_geometry(
+                    mesh,
+                    spheres,
+                    &frame,
+                    &other_bones,
+                    orientation,
+                    params.leaf_extent_ratio,
                 );
+                if !owns {
+                    return JointPlan::Skip(
+                        "end site: the surface does not run on past the joint".into(),
+                    );
+                }
             }
             JointPlan::Boundary(frame)
         })
         .collect()
 }
 
-/// Rule 5: whether leaf `j` owns geometry (see the module doc).
-#[allow(clippy::too_many_arguments)]
+/// Rule 5: whether the leaf of `frame` owns geometry. `other_bones`: the bones not at the
+/// leaf, as segments; `orientation` as from [`orientation_sign`].
 fn leaf_owns_geometry(
     mesh: &SurfaceMesh,
     spheres: &FaceSpheres,
-    skeleton: &Skeleton,
-    positions: &[DVec3],
-    j: usize,
     frame: &JointFrame,
+    other_bones: &[[DVec3; 2]],
     orientation: f64,
-    params: &DecomposeParams,
+    extent_ratio: f64,
 ) -> bool {
     let (p, upper, radius) = (frame.position, frame.upper, frame.surface_distance);
-    let threshold = params.leaf_extent_ratio * radius;
-    let exit_along_bone = spheres.first_hit(mesh, p, upper).filter(|hit| {
-        orientation * mesh.scaled_normal(hit.face as usize).dot(upper) >= 0.0
-    });
+    let threshold = extent_ratio * radius;
+    let exit_along_bone = spheres
+        .first_hit(mesh, p, upper)
+        .filter(|hit| orientation * mesh.scaled_normal(hit.face as usize).dot(upper) >= 0.0);
     if exit_along_bone.is_some_and(|hit| hit.distance >= threshold) {
         return true;
     }
     if radius < INTERIOR_RADIUS * frame.bone_length {
         return false;
     }
-    let other_bones: Vec<[DVec3; 2]> = (0..skeleton.len())
-        .filter_map(|c| skeleton.parent(c).map(|q| (q, c)))
-        .filter(|&(q, c)| q != j && c != j)
-        .map(|(q, c)| [positions[q], positions[c]])
-        .collect();
     let reach_threshold = LEAF_REACH_RATIO * radius;
-    leaf_reach(mesh, spheres, p, upper, &other_bones, 1.01 * reach_threshold) >= reach_threshold
+    leaf_reach(mesh, spheres, p, upper, other_bones, 2.0 * reach_threshold) >= reach_threshold
 }
 
-/// The largest distance from `p` of the surface vertices within `radius` of it that lie
-/// past it along `direction` ((v − p) · direction > 0) and nearer to `p` than to each bone
-/// of `other_bones`: how far the part beyond a leaf joint reaches.
+/// The largest distance from `p` of the surface vertices v within `radius` of it that lie
+/// past it within 60° of the unit `direction` ((v − p) · direction ≥ ½ |v − p|) and nearer
+/// to `p` than to each bone of `other_bones`: how far the part beyond a leaf joint reaches.
 fn leaf_reach(
     mesh: &SurfaceMesh,
     spheres: &FaceSpheres,
@@ -235,7 +299,9 @@ fn leaf_reach(
     vertices
         .into_iter()
         .map(|v| mesh.positions[v as usize])
-        .filter(|&v| (v - p).dot(direction) > 0.0 && v.distance(p) <= radius)
+        .filter(|&v| {
+            (v - p).dot(direction) >= PAST_COSINE * v.distance(p) && v.distance(p) <= radius
+        })
         .filter(|&v| {
             let d = v.distance(p);
             other_bones

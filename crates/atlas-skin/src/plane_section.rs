@@ -75,20 +75,24 @@ pub struct Chord {
 }
 
 /// The faces a section is computed on (near one joint), with buffers reused by every
-/// query: #V signed distances and #E visit stamps of the whole mesh, only the domain's
-/// entries touched.
+/// query. A query computes the signed distance and side of the domain's vertices only and
+/// scans the domain's faces by local vertex index; only the few crossed faces are traced
+/// through the mesh's topology, with #E visit stamps and #V, #F lookups of the whole mesh
+/// (zeroed allocations, set once per domain).
 #[derive(Debug, Clone)]
 pub struct SectionDomain {
     faces: Vec<u32>,
     /// The domain's faces as triples of local vertex indices.
     local_faces: Vec<[u32; 3]>,
-    /// Per local vertex: its global index, position, snap distance and signed distance.
-    vertices: Vec<u32>,
+    /// Per local vertex: its position, snap distance, signed distance and side (1 when
+    /// d ≥ 0, else 0: a face is crossed when its corners' sides sum to 1 or 2).
     local_positions: Vec<DVec3>,
     local_snap: Vec<f64>,
     local_distance: Vec<f64>,
+    local_side: Vec<u8>,
+    /// Per global vertex: 1 + its local index, 0 outside the domain.
+    local_of: Vec<u32>,
     in_domain: Vec<bool>,
-    distance: Vec<f64>,
     edge_stamp: Vec<u32>,
     stamp: u32,
 }
@@ -123,18 +127,19 @@ impl SectionDomain {
             })
             .collect();
         let mut in_domain = vec![false; mesh.triangle_count()];
-        let mut local_of = vec![u32::MAX; mesh.vertex_count()];
+        let mut local_of = vec![0u32; mesh.vertex_count()];
         let mut vertices = Vec::new();
         let local_faces = faces
             .iter()
             .map(|&f| {
                 in_domain[f as usize] = true;
                 mesh.triangles[f as usize].map(|v| {
-                    if local_of[v as usize] == u32::MAX {
-                        local_of[v as usize] = vertices.len() as u32;
+                    let slot = &mut local_of[v as usize];
+                    if *slot == 0 {
                         vertices.push(v);
+                        *slot = vertices.len() as u32;
                     }
-                    local_of[v as usize]
+                    *slot - 1
                 })
             })
             .collect();
@@ -147,9 +152,9 @@ impl SectionDomain {
                 .collect(),
             local_snap: vertices.iter().map(|&v| vertex_snap[v as usize]).collect(),
             local_distance: vec![0.0; vertices.len()],
-            vertices,
+            local_side: vec![0; vertices.len()],
+            local_of,
             in_domain,
-            distance: vec![0.0; mesh.vertex_count()],
             edge_stamp: vec![0; topology.edges.len()],
             stamp: 0,
         }
@@ -159,16 +164,15 @@ impl SectionDomain {
     /// domain (a face outside it, a boundary or non-manifold edge) is open and dropped.
     /// Cost O(faces of the domain).
     pub fn closed_sections(&mut self, topology: &Topology, plane: &Plane) -> Vec<SectionCurve> {
-        for (k, (p, snap)) in self
-            .local_positions
-            .iter()
-            .zip(&self.local_snap)
-            .enumerate()
+        for ((d, side), (p, snap)) in self
+            .local_distance
+            .iter_mut()
+            .zip(&mut self.local_side)
+            .zip(self.local_positions.iter().zip(&self.local_snap))
         {
-            let d = plane.signed_distance(*p);
-            let d = if d.abs() < *snap { 0.0 } else { d };
-            self.local_distance[k] = d;
-            self.distance[self.vertices[k] as usize] = d;
+            let signed = plane.signed_distance(*p);
+            *d = if signed.abs() < *snap { 0.0 } else { signed };
+            *side = u8::from(*d >= 0.0);
         }
         self.stamp = self.stamp.wrapping_add(1);
         if self.stamp == 0 {
@@ -177,8 +181,11 @@ impl SectionDomain {
         }
         let mut curves = Vec::new();
         for i in 0..self.faces.len() {
-            let [a, b, c] = self.local_faces[i].map(|v| self.local_distance[v as usize] >= 0.0);
-            if a == b && b == c {
+            let [a, b, c] = self.local_faces[i];
+            let sides = self.local_side[a as usize]
+                + self.local_side[b as usize]
+                + self.local_side[c as usize];
+            if sides == 0 || sides == 3 {
                 continue;
             }
             let f = self.faces[i] as usize;
@@ -193,18 +200,22 @@ impl SectionDomain {
         curves
     }
 
-    fn positive(&self, v: u32) -> bool {
-        self.distance[v as usize] >= 0.0
+    /// Local index of global vertex `v`, a corner of a domain face.
+    fn local(&self, v: u32) -> usize {
+        self.local_of[v as usize] as usize - 1
     }
 
     fn is_crossed(&self, topology: &Topology, e: u32) -> bool {
         let [a, b] = topology.edges[e as usize];
-        self.positive(a) != self.positive(b)
+        self.local_side[self.local(a)] != self.local_side[self.local(b)]
     }
 
     fn crossing(&self, topology: &Topology, e: u32) -> EdgeCrossing {
         let [a, b] = topology.edges[e as usize];
-        let (da, db) = (self.distance[a as usize], self.distance[b as usize]);
+        let (da, db) = (
+            self.local_distance[self.local(a)],
+            self.local_distance[self.local(b)],
+        );
         let point = if da == 0.0 {
             CrossingPoint::Vertex(a)
         } else if db == 0.0 {

@@ -2,11 +2,14 @@
 //! surface distance, faces near a point, first hit along a ray.
 //!
 //! Point queries visit a uniform grid of the sphere centres (about four faces per cell),
-//! ray queries scan the spheres linearly; the exact test runs only on faces whose sphere
-//! passes. The decomposition asks them once per joint, never once per candidate plane.
+//! ray queries descend a bounding volume hierarchy of the faces' boxes (the faces in
+//! Morton order of their centres, halved recursively: depth ⌈log₂ F⌉ at most); the exact
+//! test runs only on faces whose sphere passes.
+//! The decomposition asks them once per joint, never once per candidate plane.
 
 use crate::SurfaceMesh;
 use glam::{DVec3, IVec3};
+use rayon::slice::ParallelSliceMut;
 
 /// A bounding sphere per face (centre = centroid, radius = farthest corner from it), and
 /// a grid of the centres.
@@ -17,6 +20,7 @@ pub struct FaceSpheres {
     /// Largest radius.
     max_radius: f64,
     grid: CentreGrid,
+    bvh: FaceBvh,
 }
 
 /// Cells of side `cell` from `origin`, `dims` per axis; cell k's faces are
@@ -84,7 +88,9 @@ impl CentreGrid {
     }
 
     /// Faces whose centre lies in a cell of the box `lo..=hi` of cell coordinates, except
-    /// the cells of the box `skip_lo..=skip_hi` (pass an empty box to keep all).
+    /// the cells of the box `skip_lo..=skip_hi` (pass an empty box to keep all). Cells
+    /// x-adjacent are adjacent in `faces`, so each row of the box (or each side of the
+    /// skipped box in a row) is one slice.
     fn faces_in(
         &self,
         lo: IVec3,
@@ -93,19 +99,62 @@ impl CentreGrid {
         skip_hi: IVec3,
     ) -> impl Iterator<Item = u32> + '_ {
         let (lo, hi) = (lo.max(IVec3::ZERO), hi.min(self.dims - IVec3::ONE));
-        (lo.z..=hi.z).flat_map(move |z| {
-            (lo.y..=hi.y).flat_map(move |y| {
-                (lo.x..=hi.x)
-                    .map(move |x| IVec3::new(x, y, z))
-                    .filter(move |c| !(c.cmpge(skip_lo).all() && c.cmple(skip_hi).all()))
-                    .flat_map(move |c| {
-                        let k = self.index(c);
-                        self.faces[self.offsets[k] as usize..self.offsets[k + 1] as usize]
-                            .iter()
-                            .copied()
-                    })
+        (lo.z..=hi.z)
+            .flat_map(move |z| (lo.y..=hi.y).map(move |y| (y, z)))
+            .flat_map(move |(y, z)| {
+                let skipped = (skip_lo.y..=skip_hi.y).contains(&y)
+                    && (skip_lo.z..=skip_hi.z).contains(&z)
+                    && skip_lo.x <= skip_hi.x;
+                let (left_end, right_start) = if skipped {
+                    (skip_lo.x - 1, skip_hi.x + 1)
+                } else {
+                    (hi.x, hi.x + 1)
+                };
+                [
+                    self.row(y, z, lo.x, left_end.min(hi.x)),
+                    self.row(y, z, right_start.max(lo.x), hi.x),
+                ]
+            })
+            .flatten()
+            .copied()
+    }
+
+    /// Faces of the cells x0..=x1 of row (y, z), empty when x0 > x1.
+    fn row(&self, y: i32, z: i32, x0: i32, x1: i32) -> &[u32] {
+        if x0 > x1 {
+            return &[];
+        }
+        let (k0, k1) = (
+            self.index(IVec3::new(x0, y, z)),
+            self.index(IVec3::new(x1, y, z)),
+        );
+        &self.faces[self.offsets[k0] as usize..self.offsets[k1 + 1] as usize]
+    }
+}
+
+/// Sorts distinct face indices below `face_count`: by a bitmap of the faces, O(k + F/64),
+/// when the k indices are at least F/256 of them, else by comparison, O(k log k).
+fn sort_face_indices(faces: &mut [u32], face_count: usize) {
+    if faces.len() * 256 < face_count {
+        faces.sort_unstable();
+        return;
+    }
+    let mut bits = vec![0u64; face_count.div_ceil(64)];
+    for &f in faces.iter() {
+        bits[f as usize / 64] |= 1 << (f % 64);
+    }
+    let sorted = bits.iter().enumerate().flat_map(|(w, &word)| {
+        let mut rest = word;
+        std::iter::from_fn(move || {
+            (rest != 0).then(|| {
+                let bit = rest.trailing_zeros();
+                rest &= rest - 1;
+                (w * 64) as u32 + bit
             })
         })
+    });
+    for (slot, f) in faces.iter_mut().zip(sorted) {
+        *slot = f;
     }
 }
 
@@ -133,11 +182,13 @@ impl FaceSpheres {
             .unzip();
         let max_radius = radii.iter().copied().fold(0.0, f64::max);
         let grid = CentreGrid::new(&centres);
+        let bvh = FaceBvh::new(mesh, &centres);
         Self {
             centres,
             radii,
             max_radius,
             grid,
+            bvh,
         }
     }
 
@@ -204,31 +255,193 @@ impl FaceSpheres {
                 self.centres[f].distance_squared(p) <= (radius + self.radii[f]).powi(2)
             })
             .collect();
-        faces.sort_unstable();
+        sort_face_indices(&mut faces, self.centres.len());
         faces
     }
 
     /// First face hit by the ray `origin + t · direction`, t > 0, `direction` unit length
-    /// (Möller–Trumbore 1997 on faces whose sphere the ray meets).
+    /// (Möller–Trumbore 1997 on faces whose sphere the ray meets); of faces hit at the same
+    /// t, the lowest index. The hierarchy is descended nearer child first and a node is
+    /// skipped once its box starts beyond the best hit, so a ray costs O(log F) boxes and a
+    /// few triangles where it runs clear of the surface.
     pub fn first_hit(&self, mesh: &SurfaceMesh, origin: DVec3, direction: DVec3) -> Option<RayHit> {
+        let nodes = &self.bvh.nodes;
         let mut best: Option<RayHit> = None;
-        for (f, (c, r)) in self.centres.iter().zip(&self.radii).enumerate() {
-            let to_centre = *c - origin;
-            let along = to_centre.dot(direction);
-            if along < -r || (to_centre - direction * along).length_squared() > r * r {
+        if nodes.is_empty() {
+            return best;
+        }
+        let beyond_best =
+            |entry: f64, best: &Option<RayHit>| best.is_some_and(|h| entry > h.distance);
+        let mut stack: Vec<u32> = Vec::with_capacity(64);
+        stack.push(0);
+        while let Some(k) = stack.pop() {
+            let node = &nodes[k as usize];
+            match node.ray_entry(origin, direction) {
+                Some(entry) if !beyond_best(entry, &best) => {}
+                _ => continue,
+            }
+            if node.count > 0 {
+                let (start, end) = (node.start as usize, (node.start + node.count) as usize);
+                for &f in &self.bvh.faces[start..end] {
+                    if let Some(t) = self.sphere_hit(mesh, f as usize, origin, direction) {
+                        if best.is_none_or(|h| t < h.distance || (t == h.distance && f < h.face)) {
+                            best = Some(RayHit {
+                                face: f,
+                                distance: t,
+                            });
+                        }
+                    }
+                }
                 continue;
             }
-            let [a, b, c] = mesh.corners(f);
-            if let Some(t) = ray_triangle(origin, direction, a, b, c) {
-                if best.is_none_or(|h| t < h.distance) {
-                    best = Some(RayHit {
-                        face: f as u32,
-                        distance: t,
-                    });
-                }
+            let (first, second) = (k + 1, k + node.start);
+            let entry = |n: u32| nodes[n as usize].ray_entry(origin, direction);
+            // Pushed last, popped first: the child the ray enters first.
+            if entry(first).unwrap_or(f64::INFINITY) <= entry(second).unwrap_or(f64::INFINITY) {
+                stack.extend([second, first]);
+            } else {
+                stack.extend([first, second]);
             }
         }
         best
+    }
+
+    /// t of the ray's hit on face `f`, tested exactly only when the ray meets its sphere.
+    fn sphere_hit(
+        &self,
+        mesh: &SurfaceMesh,
+        f: usize,
+        origin: DVec3,
+        direction: DVec3,
+    ) -> Option<f64> {
+        let (c, r) = (self.centres[f], self.radii[f]);
+        let to_centre = c - origin;
+        let along = to_centre.dot(direction);
+        if along < -r || (to_centre - direction * along).length_squared() > r * r {
+            return None;
+        }
+        let [a, b, c] = mesh.corners(f);
+        ray_triangle(origin, direction, a, b, c)
+    }
+}
+
+/// Faces at most this many to a leaf of [`FaceBvh`].
+const LEAF_FACES: usize = 4;
+
+/// A bounding volume hierarchy of the faces' boxes, nodes in depth-first order: an inner
+/// node k's first child is k + 1, its second child k + `start`.
+#[derive(Debug, Clone, Default)]
+struct FaceBvh {
+    nodes: Vec<BvhNode>,
+    /// Face indices, each leaf's a contiguous run.
+    faces: Vec<u32>,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct BvhNode {
+    lo: DVec3,
+    hi: DVec3,
+    /// A leaf's first entry of `faces`; an inner node's offset to its second child (the
+    /// first follows it).
+    start: u32,
+    /// A leaf's face count; 0 for an inner node.
+    count: u32,
+}
+
+impl FaceBvh {
+    /// Orders the faces along a Morton (Z-order) curve of their centres, then halves that
+    /// order recursively: O(F log F) for the sort, O(F) for the tree, depth
+    /// ⌈log₂(F / LEAF_FACES)⌉ + 1. Boxes are padded by 1e-9 of the mesh's extent so that a
+    /// hit Möller–Trumbore rounds out of its face's box is still found.
+    fn new(mesh: &SurfaceMesh, centres: &[DVec3]) -> Self {
+        let (lo, hi) = mesh.bounding_box();
+        let pad = DVec3::splat(1e-9 * (hi - lo).max_element().max(f64::MIN_POSITIVE));
+        let boxes: Vec<[DVec3; 2]> = (0..mesh.triangle_count())
+            .map(|f| {
+                let [a, b, c] = mesh.corners(f);
+                [a.min(b).min(c) - pad, a.max(b).max(c) + pad]
+            })
+            .collect();
+        let (centre_lo, centre_hi) = crate::mesh::bounding_box(centres);
+        let scale = MORTON_CELLS / (centre_hi - centre_lo).max(DVec3::splat(f64::MIN_POSITIVE));
+        let mut keyed: Vec<(u64, u32)> = centres
+            .iter()
+            .enumerate()
+            .map(|(f, c)| (morton_code(((*c - centre_lo) * scale).as_uvec3()), f as u32))
+            .collect();
+        keyed.par_sort_unstable();
+        let mut bvh = Self {
+            nodes: Vec::with_capacity(2 * centres.len() / LEAF_FACES + 1),
+            faces: keyed.into_iter().map(|(_, f)| f).collect(),
+        };
+        if !bvh.faces.is_empty() {
+            bvh.build(0..bvh.faces.len(), &boxes);
+        }
+        bvh
+    }
+
+    /// Appends the subtree of the faces `range` of `self.faces`; returns its box.
+    fn build(&mut self, range: std::ops::Range<usize>, boxes: &[[DVec3; 2]]) -> [DVec3; 2] {
+        let index = self.nodes.len();
+        self.nodes.push(BvhNode {
+            lo: DVec3::ZERO,
+            hi: DVec3::ZERO,
+            start: range.start as u32,
+            count: range.len() as u32,
+        });
+        let [lo, hi] = if range.len() <= LEAF_FACES {
+            self.faces[range]
+                .iter()
+                .fold([DVec3::INFINITY, DVec3::NEG_INFINITY], |[lo, hi], &f| {
+                    [lo.min(boxes[f as usize][0]), hi.max(boxes[f as usize][1])]
+                })
+        } else {
+            let middle = range.start + range.len() / 2;
+            let [first_lo, first_hi] = self.build(range.start..middle, boxes);
+            self.nodes[index].start = (self.nodes.len() - index) as u32;
+            self.nodes[index].count = 0;
+            let [second_lo, second_hi] = self.build(middle..range.end, boxes);
+            [first_lo.min(second_lo), first_hi.max(second_hi)]
+        };
+        (self.nodes[index].lo, self.nodes[index].hi) = (lo, hi);
+        [lo, hi]
+    }
+}
+
+/// Cells per axis of the Morton code's grid (21 bits per axis fill 63 bits).
+const MORTON_CELLS: f64 = ((1u32 << 21) - 1) as f64;
+
+/// Interleaves the low 21 bits of x, y, z: bit i of x goes to bit 3i (Morton 1966).
+fn morton_code(cell: glam::UVec3) -> u64 {
+    let spread = |v: u32| {
+        let mut v = u64::from(v.min((1 << 21) - 1));
+        v = (v | v << 32) & 0x001f_0000_0000_ffff;
+        v = (v | v << 16) & 0x001f_0000_ff00_00ff;
+        v = (v | v << 8) & 0x100f_00f0_0f00_f00f;
+        v = (v | v << 4) & 0x10c3_0c30_c30c_30c3;
+        (v | v << 2) & 0x1249_2492_4924_9249
+    };
+    spread(cell.x) | spread(cell.y) << 1 | spread(cell.z) << 2
+}
+
+impl BvhNode {
+    /// Smallest t ≥ 0 at which the ray is in the box (slab test), `None` when it misses.
+    fn ray_entry(&self, origin: DVec3, direction: DVec3) -> Option<f64> {
+        let (mut near, mut far) = (0.0f64, f64::INFINITY);
+        for axis in 0..3 {
+            let (o, d) = (origin[axis], direction[axis]);
+            let (lo, hi) = (self.lo[axis], self.hi[axis]);
+            if d == 0.0 {
+                if o < lo || o > hi {
+                    return None;
+                }
+                continue;
+            }
+            let (t0, t1) = ((lo - o) / d, (hi - o) / d);
+            near = near.max(t0.min(t1));
+            far = far.min(t0.max(t1));
+        }
+        (near <= far).then_some(near)
     }
 }
 
@@ -338,6 +551,144 @@ mod tests {
             .all(|&f| spheres.centres[f as usize].distance(DVec3::Z) < 0.5));
     }
 
+    /// The reference for [`FaceSpheres::first_hit`]: every face, lowest index on ties.
+    fn first_hit_by_scan(mesh: &SurfaceMesh, origin: DVec3, direction: DVec3) -> Option<RayHit> {
+        (0..mesh.triangle_count())
+            .filter_map(|f| {
+                let [a, b, c] = mesh.corners(f);
+                ray_triangle(origin, direction, a, b, c).map(|t| RayHit {
+                    face: f as u32,
+                    distance: t,
+                })
+            })
+            .min_by(|x, y| x.distance.total_cmp(&y.distance).then(x.face.cmp(&y.face)))
+    }
+
+    #[test]
+    fn hierarchy_ray_hits_match_a_full_scan() {
+        let (mesh, _) = crate::shapes::bent_cylinder(0.5, 3.0, 70.0, 24, 12);
+        let spheres = FaceSpheres::new(&mesh);
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let mut hits = 0;
+        for _ in 0..2000 {
+            let origin = DVec3::new(next() * 0.6, next() * 1.5 + 1.5, next() * 0.6);
+            let direction = DVec3::new(next(), next(), next()).normalize_or(DVec3::X);
+            let fast = spheres.first_hit(&mesh, origin, direction);
+            assert_eq!(
+                fast,
+                first_hit_by_scan(&mesh, origin, direction),
+                "{origin} {direction}"
+            );
+            hits += usize::from(fast.is_some());
+        }
+        // Rays along the axes, through vertices and edges of the grid-aligned cylinder.
+        for v in mesh.positions.iter().step_by(7) {
+            for direction in [DVec3::X, DVec3::NEG_Y, DVec3::Z] {
+                let origin = *v - direction;
+                let fast = spheres.first_hit(&mesh, origin, direction);
+                assert_eq!(
+                    fast,
+                    first_hit_by_scan(&mesh, origin, direction),
+                    "{origin}"
+                );
+            }
+        }
+        assert!(hits > 1000, "{hits} rays of 2000 hit");
+    }
+
+    /// Rays from every joint of makehuman's body and cesiumman along its bones and six
+    /// turned axes (the rays the decomposition casts), by the hierarchy and by a full scan.
+    #[test]
+    fn hierarchy_ray_hits_match_a_full_scan_on_the_corpus() {
+        use atlas_skin_io::{load_character, LoadOptions};
+        let models = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/models");
+        let cases = [
+            (
+                "makehuman/base.obj",
+                Some("makehuman/default.mhskel"),
+                Some("body"),
+            ),
+            ("cesiumman/CesiumMan.glb", None, None),
+        ];
+        let turn = glam::DQuat::from_euler(glam::EulerRot::XYZ, 0.1234, 0.2345, 0.3456);
+        for (file, skeleton, group) in cases {
+            let options = LoadOptions {
+                skeleton: skeleton.map(|s| std::path::Path::new(models).join(s)),
+                group: group.map(String::from),
+                ..Default::default()
+            };
+            let character = load_character(&std::path::Path::new(models).join(file), &options)
+                .unwrap_or_else(|e| panic!("the corpus is needed: {file}: {e}"));
+            let welded = crate::weld(
+                &character.mesh.positions,
+                &character.mesh.triangles,
+                crate::weld::DEFAULT_WELD_TOLERANCE,
+            );
+            let mesh = welded.mesh;
+            let skeleton = character.skeleton.expect("the model has a skeleton");
+            let joints: Vec<DVec3> = skeleton
+                .bind_positions()
+                .iter()
+                .map(|p| p.as_dvec3())
+                .collect();
+            let spheres = FaceSpheres::new(&mesh);
+            let mut hits = 0;
+            for (j, &p) in joints.iter().enumerate() {
+                let bone = skeleton
+                    .parent(j)
+                    .and_then(|q| (p - joints[q]).try_normalize());
+                let axes = [
+                    DVec3::X,
+                    DVec3::NEG_X,
+                    DVec3::Y,
+                    DVec3::NEG_Y,
+                    DVec3::Z,
+                    DVec3::NEG_Z,
+                ];
+                for direction in axes.into_iter().map(|a| turn * a).chain(bone) {
+                    let fast = spheres.first_hit(&mesh, p, direction);
+                    assert_eq!(
+                        fast,
+                        first_hit_by_scan(&mesh, p, direction),
+                        "{file} joint {j}"
+                    );
+                    hits += usize::from(fast.is_some());
+                }
+            }
+            assert!(hits > joints.len(), "{file}: {hits} hits");
+        }
+    }
+
+    #[test]
+    fn morton_codes_interleave_the_axes() {
+        let code = |x, y, z| morton_code(glam::UVec3::new(x, y, z));
+        assert_eq!(
+            [code(1, 0, 0), code(0, 1, 0), code(0, 0, 1), code(2, 0, 0)],
+            [1, 2, 4, 8]
+        );
+        assert_eq!(code(3, 5, 6), 0b110_101_011);
+        let top = (1 << 21) - 1;
+        assert_eq!(code(top, top, top), (1u64 << 63) - 1);
+    }
+
+    #[test]
+    fn face_indices_sort_by_bitmap_and_by_comparison() {
+        // 100 of 100 000 faces sort by comparison, 4 of 130 by bitmap.
+        for (face_count, step) in [(100_000, 1000), (130, 37)] {
+            let mut faces: Vec<u32> = (0..face_count as u32).rev().step_by(step).collect();
+            let mut expected = faces.clone();
+            expected.sort_unstable();
+            sort_face_indices(&mut faces, face_count);
+            assert_eq!(faces, expected, "{face_count} faces");
+        }
+    }
+
     #[test]
     fn grid_nearest_distance_matches_a_full_scan() {
         let (mesh, _) = crate::shapes::bent_cylinder(0.5, 3.0, 70.0, 24, 12);
@@ -361,6 +712,14 @@ mod tests {
             let p = DVec3::new(next() * 5.0 - 1.5, next() * 7.0 - 1.0, next() * 3.0 - 1.5);
             let (grid, scan) = (spheres.nearest_distance(&mesh, p), full(p));
             assert!((grid - scan).abs() < 1e-12, "{p}: {grid} vs {scan}");
+            let radius = next();
+            let near: Vec<u32> = (0..mesh.triangle_count() as u32)
+                .filter(|&f| {
+                    let f = f as usize;
+                    spheres.centres[f].distance_squared(p) <= (radius + spheres.radii[f]).powi(2)
+                })
+                .collect();
+            assert_eq!(spheres.faces_near(p, radius), near, "{p} {radius}");
         }
     }
 }

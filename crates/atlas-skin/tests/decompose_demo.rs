@@ -39,6 +39,13 @@ fn the_demo_character_gets_exactly_the_expected_cuts_and_regions() {
         );
     }
     assert_eq!(cuts, expected.len(), "cut joints: {cut:?}");
+    // The chest branches on the mirror plane within its own cross-section: a soft boundary.
+    let chest = d.joints.iter().find(|j| j.name == "chest").expect("chest");
+    assert!(
+        matches!(&chest.status, JointStatus::Soft(r) if r.contains("mirror plane")),
+        "{:?}",
+        chest.status
+    );
     assert_eq!(d.regions.len(), expected.len() + 1);
 
     // Each cut joint's child region is its own: the region lists it first.

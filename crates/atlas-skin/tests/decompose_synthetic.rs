@@ -130,6 +130,26 @@ fn a_leaf_whose_bone_runs_on_into_the_mesh_owns_its_part() {
 }
 
 #[test]
+fn a_leaf_whose_part_turns_away_from_its_bone_owns_it_and_an_end_site_does_not() {
+    // A foot: the leaf sits at the bend, its bone points into the outer wall (the ray along
+    // it leaves the surface about one radius away), the tube runs on past it, turned 45°
+    // like toes beyond the ball of a foot.
+    let (mesh, bent) = bent_cylinder(0.5, 3.0, 45.0, 24, 16);
+    let rig = skeleton(
+        &["root", "ball"],
+        &[NO_PARENT, 0],
+        &[DVec3::ZERO, DVec3::Y * 3.0],
+    );
+    let d = run(&mesh, &rig);
+    check_decomposition(&d, true);
+    let ball = d.joints.iter().find(|j| j.name == "ball").expect("ball");
+    assert!(ball.boundary.is_some(), "{:?}", ball.status);
+    // The chain's own end joint lies inside the far cap: an end site.
+    let d = run(&mesh, &bent);
+    assert!(matches!(status(&d, "end"), JointStatus::Skipped(r) if r.starts_with("end site")));
+}
+
+#[test]
 fn joints_outside_the_mesh_are_skipped_and_explained() {
     let (mesh, _) = bent_cylinder(0.5, 3.0, 45.0, 24, 16);
     let rig = skeleton(

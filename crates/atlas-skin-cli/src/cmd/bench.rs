@@ -5,11 +5,18 @@
 //! `bandwidth_fraction = vertices/s × bytes read and written per vertex ÷ copy bandwidth`:
 //! how close skinning comes to a plain copy of its streams. Near 1 the loop is memory
 //! bound (a mesh that does not fit in cache); far below 1 it is compute bound.
+//!
+//! The copy moves as many bytes as a frame reads and writes, on the same thread pool, in
+//! as many tasks as the skinning job, so that both see the same caches (a mesh that fits
+//! in cache is compared with a copy that fits too). The machine is shared: frames of
+//! both methods and copies are interleaved, so that every figure sees the same load, and
+//! each figure is the median of its frames.
 
 use super::pose::{Posable, POSE_INFLUENCES};
 use crate::input::InputArgs;
 use anyhow::{ensure, Context, Result};
 use atlas_skin_runtime::random_pose::random_rotations;
+use atlas_skin_runtime::skinning_job::PARALLEL_CHUNK;
 use atlas_skin_runtime::{
     CompactSkin, SkinningJob, SkinningMethod, SkinningPalette, Threading, VertexWeights,
 };
@@ -53,9 +60,6 @@ static GLOBAL: CountingAllocator = CountingAllocator;
 /// Distinct random poses cycled through the frames (palettes are prepared per frame).
 const POSES: usize = 16;
 
-/// Bytes the copy-bandwidth measurement moves per pass at least: beyond any cache.
-const MIN_COPY_BYTES: usize = 256 << 20;
-
 /// Arguments.
 #[derive(clap::Args)]
 pub struct Args {
@@ -75,7 +79,7 @@ pub struct Args {
     pub json: bool,
 }
 
-/// What one run measures.
+/// What one run measures: rates from the median frame, bandwidth from the median copy.
 #[derive(Debug, serde::Serialize)]
 pub struct BenchReport {
     pub vertices: usize,
@@ -106,7 +110,7 @@ pub fn run(args: Args) -> Result<()> {
         .context("the character has no skin weights")?;
     let count = args.vertices.unwrap_or(posable.rest_positions.len());
     ensure!(count >= 1, "--vertices must be at least 1");
-    let streams = Streams::replicate(&posable, weights, count)?;
+    let mut streams = Streams::replicate(&posable, weights, count)?;
     let palettes: Vec<Vec<Mat4>> = (0..POSES as u64)
         .map(|seed| {
             posable.palette(&posable.with_rotations(&random_rotations(
@@ -125,28 +129,11 @@ pub fn run(args: Args) -> Result<()> {
     } else {
         Threading::Parallel
     };
-    let (lbs_seconds, lbs_allocations) = pool.install(|| {
-        time_frames(
-            &streams,
-            &palettes,
-            SkinningMethod::LinearBlend,
-            threading,
-            args.frames,
-        )
-    })?;
-    let (dqs_seconds, dqs_allocations) = pool.install(|| {
-        time_frames(
-            &streams,
-            &palettes,
-            SkinningMethod::DualQuaternion,
-            threading,
-            args.frames,
-        )
-    })?;
-    let copy_bandwidth = pool.install(|| copy_bandwidth(streams.bytes_per_vertex() * count));
+    let timings = pool.install(|| measure(&mut streams, &palettes, threading, args.frames))?;
     let frames = args.frames as f64;
-    let lbs_rate = count as f64 * frames / lbs_seconds;
-    let dqs_rate = count as f64 * frames / dqs_seconds;
+    let lbs_rate = count as f64 / timings.lbs;
+    let dqs_rate = count as f64 / timings.dqs;
+    let copy_bandwidth = streams.copy_bytes() as f64 / timings.copy;
     let bytes = streams.bytes_per_vertex();
     let report = BenchReport {
         vertices: count,
@@ -155,7 +142,7 @@ pub fn run(args: Args) -> Result<()> {
         influences: streams.skin.influences(),
         lbs_vertices_per_second: lbs_rate,
         dqs_vertices_per_second: dqs_rate,
-        allocations_per_frame: (lbs_allocations + dqs_allocations) as f64 / (2.0 * frames),
+        allocations_per_frame: timings.allocations as f64 / (2.0 * frames),
         memcpy_bytes_per_second: copy_bandwidth,
         bytes_per_vertex: bytes,
         bandwidth_fraction: lbs_rate * bytes as f64 / copy_bandwidth,
@@ -199,6 +186,9 @@ struct Streams {
     rest_normals: Vec<Vec3>,
     out_positions: Vec<Vec3>,
     out_normals: Vec<Vec3>,
+    /// Each half of a frame's bytes: what a copy pass reads and writes.
+    copy_source: Vec<u64>,
+    copy_target: Vec<u64>,
 }
 
 impl Streams {
@@ -211,8 +201,11 @@ impl Streams {
             VertexWeights::from_rows((0..count).map(|v| weights.row(tile(v)).collect::<Vec<_>>()));
         let skin = CompactSkin::new(&rows, posable.skeleton.len(), POSE_INFLUENCES)
             .context("invalid skin weights")?;
+        let copy_len = (bytes_per_vertex(skin.influences()) * count / 2).div_ceil(8);
         Ok(Self {
             skin,
+            copy_source: vec![1; copy_len],
+            copy_target: vec![0; copy_len],
             rest_positions: (0..count)
                 .map(|v| posable.rest_positions[tile(v)])
                 .collect(),
@@ -222,73 +215,126 @@ impl Streams {
         })
     }
 
-    /// Read: position, normal, K u16 joints, K − 1 f32 weights; written: position, normal.
     fn bytes_per_vertex(&self) -> usize {
-        let vec3 = std::mem::size_of::<Vec3>();
-        let k = self.skin.influences();
-        2 * vec3 + 2 * k + 4 * (k - 1) + 2 * vec3
+        bytes_per_vertex(self.skin.influences())
     }
-}
 
-/// Seconds for `frames` frames (palette preparation plus skinning) after one warm-up
-/// frame, and the allocations made meanwhile.
-fn time_frames(
-    streams: &Streams,
-    palettes: &[Vec<Mat4>],
-    method: SkinningMethod,
-    threading: Threading,
-    frames: usize,
-) -> Result<(f64, u64)> {
-    let mut palette = SkinningPalette::new(streams.skin.joint_count());
-    let mut out_positions = streams.out_positions.clone();
-    let mut out_normals = streams.out_normals.clone();
-    let mut frame = |k: usize| -> Result<()> {
+    /// Bytes a copy pass reads plus writes: about those of a frame.
+    fn copy_bytes(&self) -> usize {
+        2 * std::mem::size_of_val(self.copy_source.as_slice())
+    }
+
+    /// Seconds to prepare `palette` for `pose` and skin every vertex with it.
+    fn skin_frame(
+        &mut self,
+        palette: &mut SkinningPalette,
+        pose: &[Mat4],
+        method: SkinningMethod,
+        threading: Threading,
+    ) -> Result<f64> {
+        let start = Instant::now();
         palette
-            .update(&palettes[k % palettes.len()], method)
+            .update(pose, method)
             .context("cannot skin the benchmark pose")?;
         SkinningJob {
-            skin: &streams.skin,
-            palette: &palette,
+            skin: &self.skin,
+            palette,
             threading,
-            rest_positions: &streams.rest_positions,
-            rest_normals: Some(&streams.rest_normals),
+            rest_positions: &self.rest_positions,
+            rest_normals: Some(&self.rest_normals),
             rest_tangents: None,
-            out_positions: &mut out_positions,
-            out_normals: Some(&mut out_normals),
+            out_positions: &mut self.out_positions,
+            out_normals: Some(&mut self.out_normals),
             out_tangents: None,
         }
         .run()?;
-        Ok(())
-    };
-    frame(0)?;
-    let allocations_before = ALLOCATIONS.load(Ordering::Relaxed);
-    let start = Instant::now();
-    for k in 0..frames {
-        frame(k)?;
+        Ok(start.elapsed().as_secs_f64())
     }
-    let seconds = start.elapsed().as_secs_f64();
-    let allocations = ALLOCATIONS.load(Ordering::Relaxed) - allocations_before;
-    std::hint::black_box((&out_positions, &out_normals));
-    Ok((seconds, allocations))
+
+    /// Seconds to copy the copy source to the copy target on the current thread pool, in
+    /// as many tasks as a skinning job of the same vertices.
+    fn copy_pass(&mut self) -> f64 {
+        let chunk = (PARALLEL_CHUNK * self.bytes_per_vertex() / 2).div_ceil(8);
+        let start = Instant::now();
+        self.copy_target
+            .par_chunks_mut(chunk)
+            .zip(self.copy_source.par_chunks(chunk))
+            .for_each(|(target, source)| target.copy_from_slice(source));
+        start.elapsed().as_secs_f64()
+    }
 }
 
-/// Copy bandwidth of the current thread pool, bytes read plus written per second: the
-/// best of a few parallel copies of at least [`MIN_COPY_BYTES`] (and at least
-/// `working_set` bytes) in chunks of the skinning job's size.
-fn copy_bandwidth(working_set: usize) -> f64 {
-    let len = working_set.max(MIN_COPY_BYTES) / 8;
-    let source = vec![1u64; len];
-    let mut target = vec![0u64; len];
-    let chunk = atlas_skin_runtime::skinning_job::PARALLEL_CHUNK * 8;
-    let mut best = f64::MAX;
-    for _ in 0..5 {
-        let start = Instant::now();
-        target
-            .par_chunks_mut(chunk)
-            .zip(source.par_chunks(chunk))
-            .for_each(|(t, s)| t.copy_from_slice(s));
-        best = best.min(start.elapsed().as_secs_f64());
-        std::hint::black_box(&target);
+/// Bytes a vertex with `k` influences reads (position, normal, k u16 joints, k − 1 f32
+/// weights) and writes (position, normal).
+fn bytes_per_vertex(k: usize) -> usize {
+    let vec3 = std::mem::size_of::<Vec3>();
+    2 * vec3 + 2 * k + 4 * (k - 1) + 2 * vec3
+}
+
+/// Median seconds of a frame of each method and of a copy pass, and the allocations the
+/// frames made.
+struct Timings {
+    lbs: f64,
+    dqs: f64,
+    copy: f64,
+    allocations: u64,
+}
+
+/// Times `frames` rounds of: a linear blend frame, a dual quaternion frame (each a palette
+/// preparation plus skinning) and a copy of [`Streams::copy_bytes`], after one warm-up
+/// round (page faults of the first touch, thread start-up).
+fn measure(
+    streams: &mut Streams,
+    palettes: &[Vec<Mat4>],
+    threading: Threading,
+    frames: usize,
+) -> Result<Timings> {
+    let joints = streams.skin.joint_count();
+    let mut lbs_palette = SkinningPalette::new(joints);
+    let mut dqs_palette = SkinningPalette::new(joints);
+    let mut seconds = [vec![0.0; frames], vec![0.0; frames], vec![0.0; frames]];
+    let mut allocations = 0;
+    for round in 0..=frames {
+        let pose = &palettes[round % palettes.len()];
+        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        let lbs = streams.skin_frame(
+            &mut lbs_palette,
+            pose,
+            SkinningMethod::LinearBlend,
+            threading,
+        )?;
+        let dqs = streams.skin_frame(
+            &mut dqs_palette,
+            pose,
+            SkinningMethod::DualQuaternion,
+            threading,
+        )?;
+        let after = ALLOCATIONS.load(Ordering::Relaxed);
+        let copy = streams.copy_pass();
+        // Round 0 warms up.
+        if let Some(previous) = round.checked_sub(1) {
+            for (samples, s) in seconds.iter_mut().zip([lbs, dqs, copy]) {
+                samples[previous] = s;
+            }
+            allocations += after - before;
+        }
     }
-    2.0 * (len * 8) as f64 / best
+    std::hint::black_box((
+        &streams.out_positions,
+        &streams.out_normals,
+        &streams.copy_target,
+    ));
+    let [lbs, dqs, copy] = seconds.map(median);
+    Ok(Timings {
+        lbs,
+        dqs,
+        copy,
+        allocations,
+    })
+}
+
+/// The median of a non-empty sample.
+fn median(mut samples: Vec<f64>) -> f64 {
+    samples.sort_unstable_by(f64::total_cmp);
+    samples[samples.len() / 2]
 }

@@ -97,6 +97,21 @@ fn components_of(type_name: &str) -> Option<usize> {
     })
 }
 
+/// Bytes of one element of the accessor JSON `object`, from its `componentType` and
+/// `type`; `None` when either is not a glTF one, and for MAT2/MAT3 of 1- or 2-byte
+/// components, whose columns are padded to 4 bytes (glTF 2.0 §3.6.2.4).
+pub(crate) fn element_size(object: &Value) -> Option<usize> {
+    let component = object
+        .get("componentType")
+        .and_then(Value::as_u64)
+        .and_then(ComponentType::from_code)?;
+    let type_name = opt_str(object, "type")?;
+    if matches!(type_name, "MAT2" | "MAT3") && component.size() < 4 {
+        return None;
+    }
+    Some(components_of(type_name)? * component.size())
+}
+
 /// Largest element count of an accessor without a bufferView (all zeros, possibly made
 /// sparse): such an accessor has no bytes to bound its count, so a limit keeps a bad file
 /// from asking for an arbitrary allocation.

@@ -12,17 +12,23 @@ const GLB_HEADER_BYTES: usize = 12;
 const CHUNK_HEADER_BYTES: usize = 8;
 const CHUNK_JSON: u32 = 0x4E4F_534A;
 const CHUNK_BIN: u32 = 0x004E_4942;
+/// The UTF-8 byte-order mark, which glTF JSON must not start with (glTF 2.0 asks for UTF-8
+/// without BOM) but some exporters write.
+const UTF8_BOM: &[u8; 3] = b"\xEF\xBB\xBF";
 
-/// A glTF document as read: its JSON and the bytes of every buffer, in `buffers` order.
+/// A glTF document as read: its JSON, the bytes of every buffer (in `buffers` order) and
+/// warnings about tolerated departures from the format.
 pub(crate) struct Container {
     pub json: Value,
     pub buffers: Vec<Vec<u8>>,
+    pub warnings: Vec<String>,
 }
 
 /// Reads the `.glb`, `.vrm` or `.gltf` file at `path` and every buffer it refers to.
 ///
 /// The content decides the container: a file starting with `glTF` is a binary, anything
-/// else must be a `.gltf` JSON file.
+/// else must be a `.gltf` JSON file. JSON starting with a UTF-8 byte-order mark is read
+/// with a warning.
 pub(crate) fn read_container(path: &Path) -> Result<Container, IoError> {
     let bytes = read_file(path)?;
     let is_binary_name = matches!(extension(path).as_str(), "glb" | "vrm");
@@ -40,9 +46,25 @@ pub(crate) fn read_container(path: &Path) -> Result<Container, IoError> {
     } else {
         (bytes.as_slice(), None)
     };
+    let mut warnings = Vec::new();
+    let json_bytes = match json_bytes.strip_prefix(UTF8_BOM) {
+        Some(rest) => {
+            warnings.push(
+                "the JSON starts with a UTF-8 byte-order mark, which glTF does not allow; \
+                 ignored"
+                    .to_string(),
+            );
+            rest
+        }
+        None => json_bytes,
+    };
     let json = parse_json(path, json_bytes)?;
     let buffers = load_buffers(path, &json, bin)?;
-    Ok(Container { json, buffers })
+    Ok(Container {
+        json,
+        buffers,
+        warnings,
+    })
 }
 
 /// The file's bytes; a directory or an empty file is an error of its own.

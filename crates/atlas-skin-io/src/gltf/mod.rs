@@ -17,6 +17,7 @@ mod output;
 mod prune;
 mod read;
 mod rewrite;
+mod view_span;
 mod write;
 
 pub use debug::write_debug_glb;

@@ -7,7 +7,9 @@
 //! reference that is not a valid index, is left exactly as it is.
 
 use super::builder::GlbBuilder;
+use super::view_span::used_spans;
 use serde_json::{json, Map, Value};
+use std::ops::Range;
 
 /// Extensions that hold no index into `accessors` or `bufferViews` (they name materials,
 /// textures, images, nodes or meshes, which are never renumbered here).
@@ -54,6 +56,7 @@ enum Step {
 use Step::{Items, Key, Values};
 
 /// Where an accessor index can occur, from the document root.
+#[rustfmt::skip]
 const ACCESSOR_REFERENCES: [&[Step]; 6] = [
     &[Key("meshes"), Items, Key("primitives"), Items, Key("attributes"), Values],
     &[Key("meshes"), Items, Key("primitives"), Items, Key("indices")],
@@ -100,15 +103,17 @@ fn for_each_at(value: &mut Value, path: &[Step], visit: &mut dyn FnMut(&mut Valu
 }
 
 /// Sets `used[i]` for every index found at `paths` under `value`; false when one is not an
-/// index below `used.len()`.
+/// index below `used.len()`. (`value` is only read; `&mut` shares the walker with
+/// [`renumber`].)
 fn mark(value: &mut Value, paths: &[&[Step]], used: &mut [bool]) -> bool {
     let mut valid = true;
     for path in paths {
-        for_each_at(value, path, &mut |reference| {
-            match reference.as_u64().and_then(|i| used.get_mut(i as usize)) {
-                Some(slot) => *slot = true,
-                None => valid = false,
-            }
+        for_each_at(value, path, &mut |reference| match reference
+            .as_u64()
+            .and_then(|i| used.get_mut(i as usize))
+        {
+            Some(slot) => *slot = true,
+            None => valid = false,
         });
     }
     valid
@@ -119,10 +124,7 @@ fn mark(value: &mut Value, paths: &[&[Step]], used: &mut [bool]) -> bool {
 fn renumber(value: &mut Value, paths: &[&[Step]], new_index: &[Option<usize>]) {
     for path in paths {
         for_each_at(value, path, &mut |reference| {
-            if let Some(&Some(new)) = reference
-                .as_u64()
-                .and_then(|i| new_index.get(i as usize))
-            {
+            if let Some(&Some(new)) = reference.as_u64().and_then(|i| new_index.get(i as usize)) {
                 *reference = json!(new);
             }
         });
@@ -201,11 +203,12 @@ impl References {
 }
 
 /// `builder` without the accessors and bufferViews (and their bytes) that `input` (the
-/// references of the document before the rewrite) used and nothing uses any more; all
-/// other items keep their order, and every reference is renumbered. Items appended by the
-/// rewrite (indices past `input`'s) are referenced by construction and kept. The builder
-/// comes back unchanged when `input` is `None` or the rewritten document cannot be
-/// followed.
+/// references of the document before the rewrite) used and nothing uses any more; a kept
+/// view that a dropped accessor also used is cut to the span the kept accessors read
+/// ([`used_spans`]). All other items keep their order and bytes, and every reference is
+/// renumbered. Items the rewrite appended (indices past `input`'s) are kept when
+/// referenced, which they all are. The builder comes back unchanged when `input` is
+/// `None` or the rewritten document cannot be followed.
 pub(crate) fn drop_orphans(mut builder: GlbBuilder, input: Option<&References>) -> GlbBuilder {
     let Some(input) = input else {
         return builder;
@@ -221,10 +224,16 @@ pub(crate) fn drop_orphans(mut builder: GlbBuilder, input: Option<&References>) 
         .map(|(i, &used)| used || input.views.get(i) == Some(&false))
         .collect();
     let (mut json, bin) = builder.into_parts();
-    let Some(view_bytes) = view_ranges(&json, &keep_views, bin.len()) else {
+    let spans = used_spans(
+        &json,
+        &output.accessors,
+        &views_of_dropped_accessors(&json, input, &output),
+    );
+    let Some(view_bytes) = view_ranges(&json, &keep_views, &spans, bin.len()) else {
         return GlbBuilder::from_parts(json, bin);
     };
     let accessor_index = keep_and_number(&mut json, "accessors", &output.accessors);
+    shift_accessors(&mut json, &spans);
     let view_index = keep_and_number(&mut json, "bufferViews", &keep_views);
     let mut document = Value::Object(json);
     renumber(&mut document, &ACCESSOR_REFERENCES, &accessor_index);
@@ -240,31 +249,85 @@ pub(crate) fn drop_orphans(mut builder: GlbBuilder, input: Option<&References>) 
     let mut pruned = GlbBuilder::new(json);
     for (view, range) in view_bytes.into_iter().enumerate() {
         let offset = pruned.append_bytes(&bin[range.clone()], range.start);
-        pruned.json_mut()["bufferViews"][view]["byteOffset"] = json!(offset);
+        let view = &mut pruned.json_mut()["bufferViews"][view];
+        view["byteOffset"] = json!(offset);
+        view["byteLength"] = json!(range.len());
     }
     pruned
 }
 
-/// The byte range in `bin` of every bufferView kept by `keep`, in order; `None` when one
-/// is not a range of buffer 0 (all views of a rewritten document are).
+/// Marks the bufferViews (dense data) of the accessors `input` used and `output` drops:
+/// those may keep bytes nothing reads any more.
+fn views_of_dropped_accessors(
+    json: &Map<String, Value>,
+    input: &References,
+    output: &References,
+) -> Vec<bool> {
+    let mut views = vec![false; output.views.len()];
+    let Some(Value::Array(accessors)) = json.get("accessors") else {
+        return views;
+    };
+    for (accessor, (&used, &kept)) in accessors
+        .iter()
+        .zip(input.accessors.iter().zip(&output.accessors))
+    {
+        let view = accessor.get("bufferView").and_then(Value::as_u64);
+        if let (true, false, Some(slot)) =
+            (used, kept, view.and_then(|v| views.get_mut(v as usize)))
+        {
+            *slot = true;
+        }
+    }
+    views
+}
+
+/// Moves every accessor reading a view of `spans` back by the bytes cut off the view's
+/// start. Called on the kept accessors only (before their views are renumbered): each
+/// starts at or after its view's span.
+fn shift_accessors(json: &mut Map<String, Value>, spans: &[Option<Range<usize>>]) {
+    let Some(Value::Array(accessors)) = json.get_mut("accessors") else {
+        return;
+    };
+    for accessor in accessors {
+        let view = accessor.get("bufferView").and_then(Value::as_u64);
+        let Some(Some(span)) = view.and_then(|v| spans.get(v as usize)) else {
+            continue;
+        };
+        if span.start > 0 {
+            let offset = accessor
+                .get("byteOffset")
+                .and_then(Value::as_u64)
+                .unwrap_or(0) as usize;
+            accessor["byteOffset"] = json!(offset - span.start);
+        }
+    }
+}
+
+/// The byte range in `bin` of every bufferView kept by `keep`, in order, narrowed to its
+/// used span when `spans` has one; `None` when a view is not a range of buffer 0 (all views
+/// of a rewritten document are) or a span does not lie inside its view.
 fn view_ranges(
     json: &Map<String, Value>,
     keep: &[bool],
+    spans: &[Option<Range<usize>>],
     bin_length: usize,
-) -> Option<Vec<std::ops::Range<usize>>> {
+) -> Option<Vec<Range<usize>>> {
     let views = match json.get("bufferViews") {
         Some(Value::Array(views)) => views.as_slice(),
         _ => &[],
     };
     views
         .iter()
-        .zip(keep)
-        .filter(|(_, &kept)| kept)
-        .map(|(view, _)| {
+        .zip(keep.iter().zip(spans))
+        .filter(|(_, (&kept, _))| kept)
+        .map(|(view, (_, span))| {
             let field = |key: &str| view.get(key).and_then(Value::as_u64);
             let start = field("byteOffset").unwrap_or(0) as usize;
-            let end = start.checked_add(field("byteLength")? as usize)?;
-            (field("buffer") == Some(0) && end <= bin_length).then_some(start..end)
+            let length = field("byteLength")? as usize;
+            let used = span.clone().unwrap_or(0..length);
+            let end = start.checked_add(used.end)?;
+            let valid = field("buffer") == Some(0) && used.end <= length && end <= bin_length;
+            valid.then_some(start + used.start..end)
         })
         .collect()
 }
@@ -290,4 +353,98 @@ fn keep_and_number(json: &mut Map<String, Value>, key: &str, keep: &[bool]) -> V
             .collect();
     }
     new_index
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A document as a rewrite leaves it, with `extra` merged in: views 0..=7 over 4-byte
+    /// blocks of the BIN (block i filled with i); accessor 1 (the old JOINTS_0, the only user
+    /// of view 1) replaced by accessor 4 (view 7); accessor 3 and view 6 unused by the input
+    /// itself. Returns the builder and the input's references.
+    fn rewritten(extra: Value) -> (GlbBuilder, Option<References>) {
+        let views: Vec<Value> = (0..7)
+            .map(|i| json!({"buffer": 0, "byteOffset": 4 * i, "byteLength": 4}))
+            .collect();
+        let mut input = json!({
+            "accessors": [
+                {"bufferView": 0},
+                {"bufferView": 1},
+                {"bufferView": 2, "sparse": {"count": 1, "indices": {"bufferView": 3},
+                                            "values": {"bufferView": 2}}},
+                {"bufferView": 4}
+            ],
+            "bufferViews": views,
+            "meshes": [{"primitives": [{
+                "attributes": {"POSITION": 0, "JOINTS_0": 1},
+                "targets": [{"POSITION": 2}]
+            }]}],
+            "skins": [{"joints": [0], "inverseBindMatrices": 0}],
+            "animations": [{"samplers": [{"input": 0, "output": 2, "interpolation": "LINEAR"}]}],
+            "images": [{"bufferView": 5}]
+        });
+        if let (Value::Object(input), Value::Object(extra)) = (&mut input, extra) {
+            input.extend(extra);
+        }
+        let Value::Object(json) = input else {
+            unreachable!()
+        };
+        let mut builder = GlbBuilder::new(json);
+        let references = References::of_input(builder.json_mut());
+        for i in 0..7u8 {
+            builder.append_bytes(&[i; 4], 0);
+        }
+        let view = builder.push_view(&[7; 4], None);
+        let accessor = builder.push_item("accessors", json!({"bufferView": view}));
+        builder.json_mut()["meshes"][0]["primitives"][0]["attributes"]["JOINTS_0"] =
+            json!(accessor);
+        (builder, references)
+    }
+
+    #[test]
+    fn orphans_are_dropped_and_references_renumbered() {
+        let (builder, references) = rewritten(json!({}));
+        let (json, bin) = drop_orphans(builder, references.as_ref()).into_parts();
+        let accessor_views: Vec<&Value> = json["accessors"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|a| &a["bufferView"])
+            .collect();
+        assert_eq!(accessor_views, [&json!(0), &json!(1), &json!(3), &json!(6)]);
+        assert_eq!(json["accessors"][1]["sparse"]["indices"]["bufferView"], 2);
+        assert_eq!(json["accessors"][1]["sparse"]["values"]["bufferView"], 1);
+        let primitive = &json["meshes"][0]["primitives"][0];
+        assert_eq!(
+            primitive["attributes"],
+            json!({"POSITION": 0, "JOINTS_0": 3})
+        );
+        assert_eq!(primitive["targets"][0]["POSITION"], 1);
+        assert_eq!(json["skins"][0]["inverseBindMatrices"], 0);
+        assert_eq!(json["animations"][0]["samplers"][0]["output"], 1);
+        assert_eq!(json["images"][0]["bufferView"], 4);
+        let kept_blocks = [0u8, 2, 3, 4, 5, 6, 7];
+        let expected: Vec<u8> = kept_blocks.iter().flat_map(|&b| [b; 4]).collect();
+        assert_eq!(bin, expected);
+        for (view, offset) in json["bufferViews"].as_array().unwrap().iter().zip(0..) {
+            assert_eq!(view["byteOffset"], 4 * offset);
+        }
+    }
+
+    #[test]
+    fn documents_that_cannot_be_followed_are_kept_whole() {
+        let unknown_extension = json!({
+            "nodes": [{"extensions": {"EXT_mesh_gpu_instancing": {"attributes": {"SCALE": 1}}}}]
+        });
+        let bad_reference = json!({"skins": [{"inverseBindMatrices": 0.5}]});
+        for extra in [unknown_extension, bad_reference] {
+            let unchanged = rewritten(extra.clone()).0.into_parts();
+            let (builder, references) = rewritten(extra);
+            assert_eq!(
+                drop_orphans(builder, references.as_ref()).into_parts(),
+                unchanged
+            );
+        }
+    }
 }

@@ -31,7 +31,7 @@ use std::path::Path;
 /// [`IoError`] naming the file and the problem for anything malformed: containers,
 /// JSON, out-of-range accessors or indices, non-finite positions, node cycles.
 pub fn read(path: &Path) -> Result<Character, IoError> {
-    let container = read_container(path)?;
+    let mut container = read_container(path)?;
     let doc = Document {
         json: &container.json,
         buffers: &container.buffers,
@@ -45,7 +45,7 @@ pub fn read(path: &Path) -> Result<Character, IoError> {
         None => Vec::new(),
     };
     let names = unique_node_names(&doc, &joints)?;
-    let mut warnings = Vec::new();
+    let mut warnings = std::mem::take(&mut container.warnings);
     let instances = mesh_instances(&doc, &tree, skin)?;
     let geometry = read_geometry(&doc, &instances, &mut warnings)?;
     if geometry.mesh.triangles.is_empty() {
@@ -299,7 +299,8 @@ fn read_geometry<'a>(
 }
 
 /// Positions of accessor `position` (VEC3), transformed by `world` when given; every
-/// coordinate must be finite.
+/// coordinate must be finite, as stored and after the transform. Errors show the stored
+/// values (a transform would spread one NaN over all three coordinates).
 fn read_positions(
     doc: &Document,
     position: usize,
@@ -307,19 +308,25 @@ fn read_positions(
     world: Option<Mat4>,
 ) -> Result<Vec<Vec3>, IoError> {
     let values = read_floats(doc, position, "VEC3", &format!("{location} POSITION"))?;
-    let mut positions: Vec<Vec3> = values.chunks_exact(3).map(Vec3::from_slice).collect();
-    if let Some(world) = world {
-        for p in &mut positions {
-            *p = world.transform_point3(*p);
-        }
-    }
-    if let Some(bad) = positions.iter().position(|p| !p.is_finite()) {
+    let stored: Vec<Vec3> = values.chunks_exact(3).map(Vec3::from_slice).collect();
+    let accessor = format!("{location}: POSITION (accessors[{position}])");
+    if let Some(bad) = stored.iter().position(|p| !p.is_finite()) {
         return Err(doc.error(format!(
-            "{location}: POSITION (accessors[{position}]) vertex {bad} is not finite: {}",
-            positions[bad]
+            "{accessor} vertex {bad} is not finite: {}",
+            stored[bad]
         )));
     }
-    Ok(positions)
+    let Some(world) = world else {
+        return Ok(stored);
+    };
+    let positions: Vec<Vec3> = stored.iter().map(|&p| world.transform_point3(p)).collect();
+    match positions.iter().position(|p| !p.is_finite()) {
+        Some(bad) => Err(doc.error(format!(
+            "{accessor} vertex {bad} {} is not finite after its node's world transform: {}",
+            stored[bad], positions[bad]
+        ))),
+        None => Ok(positions),
+    }
 }
 
 /// Triangles of a primitive of `mode` with vertex `indices`: TRIANGLES as stored; strips

@@ -19,7 +19,8 @@ use std::path::Path;
 /// bufferViews. For each POSITION accessor read into `character.mesh`, new JOINTS_n and
 /// WEIGHTS_n accessors are made once and put on every primitive of the skinned meshes
 /// using that POSITION accessor; JOINTS_n/WEIGHTS_n sets beyond the new ones are removed.
-/// The accessors, bufferViews and bytes only the old weights used are then dropped (see
+/// The accessors, bufferViews and bytes only the old weights used are then dropped, and a
+/// view they shared with other data is cut to what that data reads (see
 /// [`drop_orphans`]); what the input itself left unreferenced stays.
 pub(crate) fn rewrite_document(
     character: &Character,

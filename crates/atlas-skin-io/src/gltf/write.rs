@@ -95,11 +95,11 @@ pub(crate) struct PackedWeights {
 
 /// Packs the rows `vertices` of `weights` into `ceil(max_influences / 4)` sets.
 ///
-/// Per vertex: repeated joints merged, zeros dropped, the `max_influences` largest kept
-/// and normalised so that the float32 values stored sum to 1: `w_k = w_k / Σ w` for all but
-/// the last kept weight, which is `1 − Σ_{k<last} w_k` of the stored values, so the
-/// float32 sum is 1 within one rounding (≤ 1e-7). A vertex without any weight is bound
-/// fully to joint 0. Unused slots are joint 0 with weight 0.
+/// Per vertex: the `max_influences` largest weights ([`VertexWeights::pruned`]: repeated
+/// joints merged, zeros dropped), stored as float32 values that sum to 1 (see
+/// [`stored_weights`]). A vertex without any weight is bound fully to joint 0. Unused slots
+/// are joint 0 with weight 0, as glTF 2.0 ("Skinned Mesh Attributes") asks: a non-zero
+/// joint is never stored with weight 0.
 pub(crate) fn pack_weights(
     weights: &VertexWeights,
     vertices: impl ExactSizeIterator<Item = usize>,
@@ -107,37 +107,16 @@ pub(crate) fn pack_weights(
 ) -> PackedWeights {
     let sets = max_influences.div_ceil(4);
     let vertex_count = vertices.len();
+    let pruned = VertexWeights::from_rows(vertices.map(|v| weights.row(v))).pruned(max_influences);
     let mut joints = vec![vec![0u32; 4 * vertex_count]; sets];
     let mut packed = vec![vec![0f32; 4 * vertex_count]; sets];
-    let pruned_row = |v: usize| {
-        let mut row: Vec<(u32, f32)> = Vec::new();
-        for (j, w) in weights.row(v) {
-            match row.iter_mut().find(|(k, _)| *k == j) {
-                Some(entry) => entry.1 += w,
-                None => row.push((j, w)),
-            }
-        }
-        row.retain(|&(_, w)| w > 0.0);
-        row.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
-        row.truncate(max_influences);
-        row
-    };
-    for (out_vertex, v) in vertices.enumerate() {
-        let mut row = pruned_row(v);
+    for v in 0..vertex_count {
+        let mut row: Vec<(u32, f32)> = pruned.row(v).collect();
         if row.is_empty() {
             row.push((0, 1.0));
         }
-        let sum: f64 = row.iter().map(|&(_, w)| w as f64).sum();
-        let mut stored_sum = 0.0f64;
-        let last = row.len() - 1;
-        for (k, &(joint, weight)) in row.iter().enumerate() {
-            let value = if k == last {
-                (1.0 - stored_sum).max(0.0) as f32
-            } else {
-                (weight as f64 / sum) as f32
-            };
-            stored_sum += value as f64;
-            let (set, slot) = (k / 4, 4 * out_vertex + k % 4);
+        for (k, (joint, value)) in stored_weights(row).into_iter().enumerate() {
+            let (set, slot) = (k / 4, 4 * v + k % 4);
             joints[set][slot] = joint;
             packed[set][slot] = value;
         }
@@ -145,6 +124,44 @@ pub(crate) fn pack_weights(
     PackedWeights {
         joints,
         weights: packed,
+    }
+}
+
+/// The float32 values stored for a row of positive weights `w` (not empty).
+///
+/// `s_k = fl(w_k / Σ w)` for all but the last entry, and `s_last = fl(1 − Σ_{k<last} s_k)`
+/// (the sum taken in f64), so the float32 sum is 1 within one rounding per addition: the
+/// glTF-Validator accepts `|Σ s − 1| ≤ 2·10⁻⁷` per non-zero weight. An entry whose stored
+/// value would be 0 (a weight negligible next to the others, or the remainder when the
+/// others round up to 1) is dropped and the rest stored again, so every stored value is
+/// positive; a single entry is stored as 1.
+fn stored_weights(mut row: Vec<(u32, f32)>) -> Vec<(u32, f32)> {
+    loop {
+        let sum: f64 = row.iter().map(|&(_, w)| w as f64).sum();
+        let last = row.len() - 1;
+        let mut stored_sum = 0.0f64;
+        let stored: Vec<(u32, f32)> = row
+            .iter()
+            .enumerate()
+            .map(|(k, &(joint, weight))| {
+                let value = if k == last {
+                    (1.0 - stored_sum).max(0.0) as f32
+                } else {
+                    (weight as f64 / sum) as f32
+                };
+                stored_sum += value as f64;
+                (joint, value)
+            })
+            .collect();
+        match stored
+            .iter()
+            .position(|&(_, value)| value.is_nan() || value <= 0.0)
+        {
+            Some(zero) => {
+                row.remove(zero);
+            }
+            None => return stored,
+        }
     }
 }
 
@@ -213,5 +230,61 @@ mod tests {
         let wide = pack_weights(&weights, [0].into_iter(), 5);
         assert_eq!(wide.joints.len(), 2);
         assert_eq!(wide.joints[1][0], 4);
+    }
+
+    /// Rows where a weight is negligible next to the others (its stored value, or the
+    /// remainder, rounds to 0 in float32; the demo character had such rows) and random
+    /// rows: no non-zero joint is stored with weight 0, and the float32 sum taken as the
+    /// glTF-Validator takes it (slot by slot, each slot across the sets) is within its
+    /// tolerance of 2e-7 per non-zero weight.
+    #[test]
+    fn stored_weights_pass_the_validator_checks() {
+        let mut rows = vec![
+            vec![(22, 0.962_682_4), (21, 0.037_317_6), (29, 1e-9)],
+            vec![(1, 0.664_466_7), (0, 0.335_533_3), (16, 3e-9)],
+            vec![(5, 1.0), (6, 1e-30), (7, 1e-38)],
+            vec![(3, 3e38), (4, 3e38)],
+        ];
+        let mut rng = atlas_skin_runtime::random_pose::SplitMix64::new(2008);
+        for _ in 0..3000 {
+            let influences = 1 + rng.next_u64() % 10;
+            rows.push(
+                (0..influences)
+                    .map(|_| {
+                        let scale = 10f64.powi(-((rng.next_u64() % 12) as i32));
+                        (
+                            (rng.next_u64() % 40) as u32,
+                            (rng.next_f64() * scale) as f32,
+                        )
+                    })
+                    .collect(),
+            );
+        }
+        let weights = VertexWeights::from_rows(rows);
+        for max_influences in [4, 8] {
+            let packed = pack_weights(&weights, 0..weights.vertex_count(), max_influences);
+            for v in 0..weights.vertex_count() {
+                let mut sum = 0f32;
+                let mut tolerance = 0f32;
+                for slot in 4 * v..4 * v + 4 {
+                    for (joints, stored) in packed.joints.iter().zip(&packed.weights) {
+                        let (joint, weight) = (joints[slot], stored[slot]);
+                        assert!(
+                            weight > 0.0 || joint == 0,
+                            "vertex {v}: joint {joint} stored with weight {weight}"
+                        );
+                        if weight > 0.0 {
+                            sum += weight;
+                            tolerance += 2e-7;
+                        }
+                    }
+                }
+                assert!(
+                    (sum - 1.0).abs() <= tolerance,
+                    "vertex {v}: sum {sum}, {:?}",
+                    weights.row(v).collect::<Vec<_>>()
+                );
+            }
+        }
     }
 }

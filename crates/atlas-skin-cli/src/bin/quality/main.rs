@@ -3,13 +3,12 @@
 //! tools' rows of `shared/data/BASELINES.md`. Run it through `scripts/quality`.
 
 mod baselines;
-mod models;
 mod table;
 
 use anyhow::{bail, Context, Result};
 use atlas_skin::eval::Evaluation;
+use atlas_skin_corpus::{Model, Reference, MODELS};
 use clap::Parser;
-use models::{Model, MODELS};
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -50,16 +49,16 @@ fn main() -> Result<()> {
     let exe = atlas_skin_exe()?;
     std::fs::create_dir_all(&args.work)
         .with_context(|| format!("cannot create {}", args.work.display()))?;
+    let weighted = || MODELS.iter().filter(|m| m.reference != Reference::None);
     for name in &args.models {
-        if !MODELS.iter().any(|m| m.name == name) {
+        if !weighted().any(|m| m.name == name) {
             bail!("unknown model {name:?}");
         }
     }
     let models_dir = args.data.join("models");
     let mut measured = Vec::new();
-    for model in MODELS
-        .iter()
-        .filter(|m| args.models.is_empty() || args.models.iter().any(|n| n == m.name))
+    for model in
+        weighted().filter(|m| args.models.is_empty() || args.models.iter().any(|n| n == m.name))
     {
         eprintln!("{}…", model.name);
         let candidate = args.work.join(format!("{}.glb", model.name));
@@ -137,7 +136,7 @@ fn run_skin(
 ) -> Result<(Option<f64>, f64)> {
     let report_path = work.join(format!("{}.report.json", model.name));
     let mut args: Vec<OsString> = vec!["skin".into()];
-    args.extend(model.input_args(models_dir, false));
+    args.extend(model.input_args_in(models_dir, false));
     args.extend([
         "-o".into(),
         candidate.into(),
@@ -165,7 +164,7 @@ fn run_skin(
 /// `atlas-skin eval MODEL CANDIDATE --json`.
 fn run_eval(exe: &Path, model: &Model, models_dir: &Path, candidate: &Path) -> Result<Evaluation> {
     let mut args: Vec<OsString> = vec!["eval".into()];
-    args.extend(model.input_args(models_dir, true));
+    args.extend(model.input_args_in(models_dir, true));
     args.extend([candidate.into(), "--json".into()]);
     if let Some(n) = model.prune_reference {
         args.extend(["--prune-reference".into(), n.to_string().into()]);
@@ -177,13 +176,8 @@ fn run_eval(exe: &Path, model: &Model, models_dir: &Path, candidate: &Path) -> R
 /// Writes the model's own reference weights as a skinned glb (the self-check candidate),
 /// keeping as many influences as the comparison does.
 fn write_reference_weights(model: &Model, models_dir: &Path, out: &Path) -> Result<()> {
-    let folder = models_dir.join(model.name);
-    let options = atlas_skin_io::LoadOptions {
-        skeleton: model.skeleton.map(|s| folder.join(s)),
-        group: model.group.map(String::from),
-        weights: model.weights.map(|w| folder.join(w)),
-    };
-    let input = folder.join(model.input);
+    let options = model.load_options_in(models_dir, true);
+    let input = model.folder_in(models_dir).join(model.input);
     let character = atlas_skin_io::load_character(&input, &options)
         .with_context(|| format!("cannot load {}", input.display()))?;
     let weights = character

@@ -1,8 +1,8 @@
 //! docs/quality.md: our figures beside the baseline rows, and the headline counts.
 
 use crate::baselines::BaselineRow;
-use crate::models::Model;
 use atlas_skin::eval::{DeformError, Evaluation};
+use atlas_skin_corpus::{Model, Reference};
 use std::fmt::Write;
 
 /// The tool every figure is held to (issue 5's goal).
@@ -171,10 +171,10 @@ pub fn render(measured: &[Measured], baselines: &[BaselineRow], candidate: &str)
 
 fn our_row(m: &Measured, candidate: &str) -> String {
     let e = &m.evaluation;
-    let model = match (m.model.group, m.model.precomputed) {
-        (_, true) => format!("{} (precomputed)", m.model.name),
-        (Some(group), false) => format!("{} ({group})", m.model.name),
-        (None, false) => m.model.name.to_string(),
+    let model = match (m.model.group, m.model.reference) {
+        (_, Reference::Precomputed) => format!("{} (precomputed)", m.model.name),
+        (Some(group), _) => format!("{} ({group})", m.model.name),
+        (None, _) => m.model.name.to_string(),
     };
     let (anim_mean, anim_max) = match e.deform_anim {
         Some(DeformError { mean, max }) => (format!("{mean:.4}"), format!("{max:.3}")),
@@ -204,8 +204,8 @@ fn seconds(s: Option<f64>) -> String {
 mod tests {
     use super::*;
     use crate::baselines::parse_baselines;
-    use crate::models::MODELS;
     use atlas_skin::eval::{Bleeding, Validity, WeightsL1};
+    use atlas_skin_corpus::MODELS;
 
     fn evaluation(mean: f64, max: f64, bleed: f64) -> Evaluation {
         Evaluation {

@@ -1,0 +1,40 @@
+//! Shared helpers of the CLI's integration tests (`mod support;`): running the
+//! `atlas-skin` binary and a fresh output folder per test. The corpus and the node
+//! checkers of tests/js are in the `atlas-skin-corpus` crate.
+
+#![allow(dead_code)] // each test binary uses a subset
+
+use std::ffi::OsStr;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// Runs `atlas-skin ARGS...` and returns what it did, success or not.
+pub fn atlas_skin<A: AsRef<OsStr>>(args: &[A]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_atlas-skin"))
+        .args(args)
+        .output()
+        .expect("cannot run atlas-skin")
+}
+
+/// Runs `atlas-skin ARGS...` and fails, with its arguments and stderr, unless it exits 0.
+pub fn atlas_skin_ok<A: AsRef<OsStr>>(args: &[A]) -> Output {
+    let output = atlas_skin(args);
+    assert!(
+        output.status.success(),
+        "atlas-skin {:?} failed: {}",
+        args.iter().map(AsRef::as_ref).collect::<Vec<_>>(),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    output
+}
+
+/// A fresh, empty output folder for one test under the target's test temp dir.
+pub fn out_dir(test: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("cli_tests")
+        .join(test);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir)
+        .unwrap_or_else(|e| panic!("cannot create {}: {e}", dir.display()));
+    dir
+}
