@@ -161,6 +161,8 @@ fn options_reach_the_method_and_bad_ones_are_refused() {
         dir.join("report.html").to_str().expect("utf-8 path"),
         "--report",
         dir.join("report.json").to_str().expect("utf-8 path"),
+        "--forbid",
+        "node8",
     ]
     .map(OsString::from);
     let output = run_skin(model, &args);
@@ -175,10 +177,12 @@ fn options_reach_the_method_and_bad_ones_are_refused() {
         &std::fs::read_to_string(dir.join("report.json")).expect("report written"),
     )
     .expect("report is JSON");
-    for joint in report["decomposition"]["joints"]
+    let joints = report["decomposition"]["joints"]
         .as_array()
-        .expect("joints")
-    {
+        .expect("joints");
+    let forbidden = joints.iter().find(|j| j["name"] == "node8").expect("node8");
+    assert_eq!(forbidden["status"], "skipped", "{forbidden}");
+    for joint in joints {
         let (Some(width), Some(diameter)) =
             (joint["overlap_width"].as_f64(), joint["diameter"].as_f64())
         else {
@@ -193,6 +197,8 @@ fn options_reach_the_method_and_bad_ones_are_refused() {
         ("--overlap", "0", "not a positive number"),
         ("--overlap-joint", "node13", "expected NAME=F"),
         ("--max-influences", "0", "at least 1"),
+        ("--forbid", "no_such_joint", "is not in the skeleton"),
+        ("--force", "no_such_joint", "is not in the skeleton"),
     ] {
         let output = run_skin(
             model,

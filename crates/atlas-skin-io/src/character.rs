@@ -69,6 +69,10 @@ pub struct Character {
     /// PLY and STL the loader drops vertices no kept triangle uses; this maps back, e.g. for
     /// MakeHuman files that index base.obj's full vertex list. Identity for glTF.
     pub file_vertex: Vec<u32>,
+    /// Joints that only mark where a bone ends and move nothing: the leaves of a TGF
+    /// skeleton (libigl's skinning handles are the bone edges, so a leaf point is never
+    /// one). The skin command gives them no boundary.
+    pub end_joints: Vec<u32>,
     /// For glTF input: the source document, its buffers and where each primitive went in
     /// `mesh` (what the glTF writer needs to preserve the document).
     pub gltf: Option<crate::gltf::GltfSource>,
@@ -98,6 +102,7 @@ impl Character {
             clips: Vec::new(),
             warnings: Vec::new(),
             file_vertex,
+            end_joints: Vec::new(),
             gltf: None,
         }
     }

@@ -125,6 +125,9 @@ fn attach_skeleton(
         "tgf" => {
             let tgf = tgf::read(path)?;
             bone_joints = Some(tgf.bones.iter().map(|&[a, _]| a).collect());
+            character.end_joints = (0..tgf.skeleton.len() as u32)
+                .filter(|&j| !tgf.bones.iter().any(|&[a, _]| a == j))
+                .collect();
             tgf.skeleton
         }
         "bvh" => {

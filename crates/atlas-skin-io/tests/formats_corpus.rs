@@ -81,6 +81,8 @@ fn arm_obj_tgf_and_per_bone_dmat() {
     // 4 bone columns land on joints tgf_1..tgf_4; the tip joint tgf_5 has no bone of its own.
     let weights = arm.reference_weights.as_ref().unwrap();
     assert!(weights.joints.iter().all(|&j| j < 4));
+    // ...so it is an end joint, which the skin command gives no boundary.
+    assert_eq!(arm.end_joints, vec![4]);
 }
 
 #[test]

@@ -14,12 +14,13 @@ use serde::{Deserialize, Serialize};
 use std::time::Instant;
 use thiserror::Error;
 
-/// Why skinning failed.
+/// Why skinning failed: the stage, with the stage's error as the source (not repeated in
+/// the message, so that chain printers show it once).
 #[derive(Debug, Error)]
 pub enum SkinError {
-    #[error("decomposition: {0}")]
+    #[error("decomposition failed")]
     Decompose(#[from] DecomposeError),
-    #[error("weights: {0}")]
+    #[error("weights failed")]
     Weights(#[from] WeightsError),
 }
 

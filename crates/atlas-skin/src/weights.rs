@@ -155,7 +155,7 @@ pub fn compute_weights(
     let vertex_count = decomposition.surface.vertex_count();
     let bands = vertex_bands(&overlaps.bands, vertex_count);
     let related = related_regions(decomposition, overlaps, &bands);
-    let softs = soft_sides(decomposition, overlaps, &related);
+    let softs = soft_sides(decomposition, skeleton, overlaps, &related);
     let trees = region_trees(decomposition, skeleton, &softs);
     let mut weights = blend_vertices(decomposition, &related, &softs, &trees, blend);
     let mut counts = fill_unweighted(decomposition, skeleton, &mut weights);
@@ -375,6 +375,10 @@ struct SoftSide {
     point: DVec3,
     normal: DVec3,
     half_width: f64,
+    /// The joint's own bones: its child bones and every bone below them.
+    own_bones: Vec<(DVec3, DVec3)>,
+    /// The other bones of the region (neither the joint's own nor its upper bone).
+    other_bones: Vec<(DVec3, DVec3)>,
     /// Bit v set when vertex v is on the child side reached along the surface.
     reached: Vec<u64>,
 }
@@ -387,7 +391,26 @@ impl SoftSide {
         }
         let signed = self.normal.dot(position - self.point);
         let w = self.half_width.max(f64::MIN_POSITIVE);
-        beta(((w + signed) / (2.0 * w)).clamp(0.0, 1.0))
+        beta(((w + signed) / (2.0 * w)).clamp(0.0, 1.0)) * self.ownership(position)
+    }
+
+    /// κ_c(p) of the module documentation: β(clamp((b − a) / w_c, 0, 1)), a and b the
+    /// distances from p to the nearest own and other bone (1 without other bones).
+    fn ownership(&self, position: DVec3) -> f64 {
+        let nearest = |bones: &[(DVec3, DVec3)]| {
+            bones
+                .iter()
+                .map(|&(a, b)| point_segment_distance(position, a, b))
+                .fold(f64::INFINITY, f64::min)
+        };
+        let other = nearest(&self.other_bones);
+        if other == f64::INFINITY {
+            return 1.0;
+        }
+        let w = self.half_width.max(f64::MIN_POSITIVE);
+        let shift: f64 = std::env::var("KSHIFT").ok().and_then(|x| x.parse().ok()).unwrap_or(0.0);
+        let scale: f64 = std::env::var("KSCALE").ok().and_then(|x| x.parse().ok()).unwrap_or(1.0);
+        beta((shift + (other - nearest(&self.own_bones)) / (scale * w)).clamp(0.0, 1.0))
     }
 }
 
@@ -399,6 +422,7 @@ impl SoftSide {
 /// no weight and its region's other joints keep it.
 fn soft_sides(
     decomposition: &Decomposition,
+    skeleton: &Skeleton,
     overlaps: &Overlaps,
     related: &Rows<(u32, f64)>,
 ) -> Vec<SoftSide> {
@@ -412,30 +436,64 @@ fn soft_sides(
             region_vertices[r as usize].push(v as u32);
         }
     }
+    let segments = bone_segments(skeleton);
+    let bind = skeleton.bind_positions();
     d.boundaries
         .par_iter()
         .enumerate()
         .filter(|(_, b)| b.kind == BoundaryKind::Soft && b.diameter > 0.0)
         .filter_map(|(k, b)| {
-            let half_width = overlaps.half_widths[k];
+            let joint = b.joint as usize;
+            let below = |mut j: usize| loop {
+                if j == joint {
+                    break true;
+                }
+                match skeleton.parent(j) {
+                    Some(p) => j = p,
+                    None => break false,
+                }
+            };
+            let upper_bone = |j: usize, end: DVec3| {
+                skeleton.parent(joint) == Some(j) && end == bind[joint].as_dvec3()
+            };
+            let (own, other): (Vec<_>, Vec<_>) = segments
+                .iter()
+                .filter(|&&(j, _, end)| {
+                    let j = j as usize;
+                    below(j)
+                        || (d.joints[j].region == Some(b.parent_region) && !upper_bone(j, end))
+                })
+                .partition(|&&(j, _, _)| below(j as usize));
+            let mut side = SoftSide {
+                joint: b.joint,
+                region: b.parent_region,
+                point: b.point,
+                normal: b.normal,
+                half_width: overlaps.half_widths[k],
+                own_bones: own.iter().map(|&&(_, a, e)| (a, e)).collect(),
+                other_bones: other.iter().map(|&&(_, a, e)| (a, e)).collect(),
+                reached: Vec::new(),
+            };
+            let half_width = side.half_width;
             let signed = |v: usize| b.normal.dot(positions[v] - b.point);
             let in_domain = |v: usize| {
-                signed(v) > -half_width && related.row(v).iter().any(|&(r, _)| r == b.parent_region)
+                signed(v) > -half_width
+                    && related.row(v).iter().any(|&(r, _)| r == b.parent_region)
+                    && side.ownership(positions[v]) > 0.0
             };
-            let mut reached = vec![0u64; vertex_count.div_ceil(64)];
-            let mut queue = VecDeque::new();
             let seed_radius = b.diameter.max(half_width);
             let candidates = &region_vertices[b.parent_region as usize];
-            let in_section = |&&v: &&u32| signed(v as usize) <= half_width && in_domain(v as usize);
             let seeds: Vec<u32> = candidates
                 .iter()
-                .filter(in_section)
                 .filter(|&&v| positions[v as usize].distance(b.point) <= seed_radius)
+                .filter(|&&v| signed(v as usize) <= half_width && in_domain(v as usize))
                 .copied()
                 .collect();
             if seeds.is_empty() {
                 return None;
             }
+            let mut reached = vec![0u64; vertex_count.div_ceil(64)];
+            let mut queue = VecDeque::new();
             for v in seeds {
                 reached[v as usize / 64] |= 1 << (v % 64);
                 queue.push_back(v);
@@ -449,14 +507,8 @@ fn soft_sides(
                     }
                 }
             }
-            Some(SoftSide {
-                joint: b.joint,
-                region: b.parent_region,
-                point: b.point,
-                normal: b.normal,
-                half_width,
-                reached,
-            })
+            side.reached = reached;
+            Some(side)
         })
         .collect()
 }

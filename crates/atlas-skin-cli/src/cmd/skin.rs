@@ -10,6 +10,7 @@ use atlas_skin::pipeline::{skin, SkinParams, Skinned, Stage};
 use atlas_skin::{weld, BoundaryKind, Topology};
 use atlas_skin_io::gltf::{write_debug_glb, write_skinned_glb, WriteOptions};
 use atlas_skin_io::Character;
+use atlas_skin_runtime::Skeleton;
 use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::{json, Value};
@@ -42,6 +43,12 @@ pub struct Args {
     /// or the paper's Eq. 1.
     #[arg(long, value_enum)]
     pub blend: Option<BlendArg>,
+    /// Give this joint a boundary even where the rules would not (repeatable).
+    #[arg(long, value_name = "JOINT")]
+    pub force: Vec<String>,
+    /// Give this joint no boundary: its part moves with its parent's (repeatable).
+    #[arg(long, value_name = "JOINT")]
+    pub forbid: Vec<String>,
     /// Influences kept per vertex (the largest, renormalised).
     #[arg(long, value_name = "N")]
     pub max_influences: Option<usize>,
@@ -72,7 +79,7 @@ impl From<BlendArg> for Blend {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let params = params(&args)?;
+    let mut params = params(&args)?;
     let character = args.input.load()?;
     let Some(skeleton) = character.skeleton.clone() else {
         bail!(
@@ -80,6 +87,7 @@ pub fn run(args: Args) -> Result<()> {
             character.path.display()
         );
     };
+    forbid_end_joints(&mut params, &character, &skeleton);
     let mut timings = serde_json::Map::new();
     let ms = |start: Instant| json!(start.elapsed().as_secs_f64() * 1e3);
 
@@ -186,7 +194,20 @@ fn params(args: &Args) -> Result<SkinParams> {
     if let Some(n) = args.max_influences {
         params.max_influences = n;
     }
+    params.decompose.force.extend(args.force.iter().cloned());
+    params.decompose.forbid.extend(args.forbid.iter().cloned());
     Ok(params)
+}
+
+/// Adds the input's end joints (TGF leaves, which move nothing) to the forbidden joints,
+/// unless the user forces them.
+fn forbid_end_joints(params: &mut SkinParams, character: &Character, skeleton: &Skeleton) {
+    for &j in &character.end_joints {
+        let name = &skeleton.names[j as usize];
+        if !params.decompose.force.contains(name) && !params.decompose.forbid.contains(name) {
+            params.decompose.forbid.push(name.clone());
+        }
+    }
 }
 
 /// A spinner with the current stage on stderr, hidden when stderr is not a terminal.
