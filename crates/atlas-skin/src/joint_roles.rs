@@ -14,14 +14,17 @@
 //!    chest, head, jaw). The paper gives it no boundary; here (METHOD.md, "extensions") it
 //!    gets one when it owns a part of the trunk. Nearer to the surface than a quarter of its
 //!    shortest bone (a jaw or tongue root in the mouth) it lies at the skin, not in a trunk:
-//!    no boundary (a soft plane there reaches down the front of the neck: METHOD.md's
-//!    bleeding face bones). Otherwise where its branches start is judged against its
-//!    section's diameter D = 2 × surface distance. Most child bones (the median) shorter
-//!    than D: it sits at the junction, its children's boundaries enclose all around it, it
-//!    owns no geometry: no boundary. Some child bone shorter than D: any plane through it
-//!    slices that branch's root: a soft boundary only. Otherwise its cut is searched like
-//!    any other but placed after all others ([`JointFrame::on_mirror_plane`]), and it is
-//!    soft when no clean cut fits.
+//!    no boundary. (Measured on makehuman: the weights stage keeps a soft boundary on the
+//!    part nearest its own bones, so the jaw's own weight no longer bleeds and `--force
+//!    jaw` changes nothing measurable; but a second branching joint at the same point,
+//!    whose bones run forward to the upper lip, takes the lip the artist leaves to the
+//!    head: bleeding .020 → .026 without this rule.) Otherwise where its branches start is
+//!    judged against its section's diameter D = 2 × surface distance. Most child bones (the
+//!    median) shorter than D: it sits at the junction, its children's boundaries enclose all
+//!    around it, it owns no geometry: no boundary. Some child bone shorter than D: any plane
+//!    through it slices that branch's root: a soft boundary only. Otherwise its cut is
+//!    searched like any other but placed after all others
+//!    ([`JointFrame::on_mirror_plane`]), and it is soft when no clean cut fits.
 //!    Off the plane (a clavicle with a breast bone, a wrist with five finger bones) a
 //!    branching joint is cut like a chain joint whose lower bone is the mean of its unit
 //!    child directions — for a wrist, the average finger direction.

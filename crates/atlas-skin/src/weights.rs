@@ -16,19 +16,29 @@
 //! 3. **Chain weights inside a region.** A region is bound to its first joint; each other
 //!    joint of the region with a soft boundary also moves part of it. Joint c's soft boundary
 //!    (plane point o_c, normal n_c toward its child, half-width w_c) gives
-//!    s_c(p) = β(clamp((w_c + n_c·(p − o_c)) / (2 w_c), 0, 1)) on its child side and 0
-//!    elsewhere. The region's joints form a tree (each soft joint under its nearest
-//!    ancestor among them, the bound joint at the root); a node of mass m keeps
-//!    m (1 − min(1, S)) and passes m s_c / max(1, S) to each child c, S = Σ_c s_c. Masses
-//!    are non-negative, sum to m, and are continuous.
+//!    s_c(p) = β(clamp((w_c + n_c·(p − o_c)) / (2 w_c), 0, 1)) · κ_c(p) on its child side
+//!    and 0 elsewhere. κ_c keeps the joint on its own part: with a(p) the distance from p
+//!    to the nearest of the joint's own bones (its child bones and every bone below them)
+//!    and b(p) to the nearest other bone of the region (bones of joints whose bone lies in
+//!    it, except the joint's own upper bone, which meets its child bones at the joint),
+//!    κ_c(p) = β(clamp(1 − (a − b) / w_c, 0, 1)), and 1 when the region has no other
+//!    bone. It is 1 wherever the own bones are the nearer and falls to 0 within one
+//!    half-width past the surface equidistant from both, as a cut's weight falls within
+//!    its overlap band: a plane whose child side holds a sibling's part (a jaw's, the front
+//!    of the neck) leaves that part to the bones that run inside it. The region's joints
+//!    form a tree (each soft joint under its nearest ancestor among them, the bound joint
+//!    at the root); a node of mass m keeps m (1 − min(1, S)) and passes m s_c / max(1, S)
+//!    to each child c, S = Σ_c s_c. Masses are non-negative, sum to m, and are continuous.
 //!
 //!    The child side is not a half-space: it is the set of vertices reached *along the
 //!    surface* from the joint's own cross-section (vertices within the plane's band and
-//!    near the joint) without crossing the far edge of the band (n_c·(p − o_c) ≤ −w_c) or
-//!    leaving the region and its overlaps. A plane through a shoulder therefore never
-//!    reaches a thigh that the hand touches, and a soft boundary acts only inside its own
-//!    region: the surface-distance guarantee of §3.3 holds for soft boundaries too. A soft
-//!    boundary with no cross-section near its joint is inactive (see `soft_sides`).
+//!    near the joint) without crossing the far edge of the band (n_c·(p − o_c) ≤ −w_c),
+//!    leaving the region and its overlaps, or reaching κ_c = 0. A plane through a shoulder
+//!    therefore never reaches a thigh that the hand touches, and a soft boundary acts only
+//!    inside its own region: the surface-distance guarantee of §3.3 holds for soft
+//!    boundaries too (κ_c, a Euclidean nearest-bone test, only ever removes vertices from
+//!    the flood, never adds any). A soft boundary with no cross-section near its joint is
+//!    inactive (see `soft_sides`).
 //! 4. **Fallback.** A vertex that no region with joints reaches (a loose piece, a
 //!    degenerate bit, a region without joints) copies the weights of the nearest weighted
 //!    vertex along the surface's edges (Dijkstra) when its component has one, and is bound
@@ -38,7 +48,7 @@ use crate::blend::{beta, blend_regions, Blend};
 use crate::geodesic::BandDistances;
 use crate::nearest_bone::{bone_segments, point_segment_distance};
 use crate::overlap::{OverlapParams, Overlaps};
-use crate::{BoundaryKind, Decomposition};
+use crate::{Boundary, BoundaryKind, Decomposition, JointDecision};
 use atlas_skin_runtime::{Skeleton, VertexWeights};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -375,12 +385,10 @@ struct SoftSide {
     point: DVec3,
     normal: DVec3,
     half_width: f64,
-    /// The joint's own bones: its child bones and every bone below them.
-    own_bones: Vec<(DVec3, DVec3)>,
-    /// The other bones of the region (neither the joint's own nor its upper bone).
-    other_bones: Vec<(DVec3, DVec3)>,
     /// Bit v set when vertex v is on the child side reached along the surface.
     reached: Vec<u64>,
+    /// κ_c of every reached vertex, by increasing vertex.
+    ownership: Vec<(u32, f64)>,
 }
 
 impl SoftSide {
@@ -389,14 +397,71 @@ impl SoftSide {
         if self.reached[v / 64] & (1 << (v % 64)) == 0 {
             return 0.0;
         }
+        let kappa = self
+            .ownership
+            .binary_search_by_key(&(v as u32), |&(u, _)| u)
+            .map_or(0.0, |i| self.ownership[i].1);
         let signed = self.normal.dot(position - self.point);
         let w = self.half_width.max(f64::MIN_POSITIVE);
-        beta(((w + signed) / (2.0 * w)).clamp(0.0, 1.0)) * self.ownership(position)
+        beta(((w + signed) / (2.0 * w)).clamp(0.0, 1.0)) * kappa
+    }
+}
+
+/// The bones that decide κ_c for one soft boundary (module documentation).
+struct Ownership {
+    /// The joint's own bones: its child bones and every bone below them.
+    own_bones: Vec<(DVec3, DVec3)>,
+    /// The other bones of the region (neither the joint's own nor its upper bone).
+    other_bones: Vec<(DVec3, DVec3)>,
+    half_width: f64,
+}
+
+impl Ownership {
+    /// The bones κ compares for the soft boundary `boundary` (module documentation), as
+    /// (start, end) segments of `segments` ([`bone_segments`]): its own bones, those of
+    /// its joint and the joints below it, and the other bones of its region, those of
+    /// every other joint whose decision lies in the region except the parent's bones
+    /// ending at the joint's position (its upper bone).
+    fn new(
+        skeleton: &Skeleton,
+        decisions: &[JointDecision],
+        segments: &[(u32, DVec3, DVec3)],
+        boundary: &Boundary,
+        half_width: f64,
+    ) -> Self {
+        let joint = boundary.joint as usize;
+        let below_joint = |mut j: usize| loop {
+            if j == joint {
+                break true;
+            }
+            match skeleton.parent(j) {
+                Some(p) => j = p,
+                None => break false,
+            }
+        };
+        let joint_position = skeleton.bind_positions()[joint].as_dvec3();
+        let upper_parent = skeleton.parent(joint);
+        let mut ownership = Self {
+            own_bones: Vec::new(),
+            other_bones: Vec::new(),
+            half_width,
+        };
+        for &(j, start, end) in segments {
+            let j = j as usize;
+            if below_joint(j) {
+                ownership.own_bones.push((start, end));
+            } else if decisions[j].region == Some(boundary.parent_region)
+                && !(upper_parent == Some(j) && end == joint_position)
+            {
+                ownership.other_bones.push((start, end));
+            }
+        }
+        ownership
     }
 
-    /// κ_c(p) of the module documentation: β(clamp((b − a) / w_c, 0, 1)), a and b the
-    /// distances from p to the nearest own and other bone (1 without other bones).
-    fn ownership(&self, position: DVec3) -> f64 {
+    /// κ_c(p) = β(clamp(1 − (a − b) / w_c, 0, 1)), a and b the distances from p to the
+    /// nearest own and other bone (1 without other bones).
+    fn at(&self, position: DVec3) -> f64 {
         let nearest = |bones: &[(DVec3, DVec3)]| {
             bones
                 .iter()
@@ -408,18 +473,17 @@ impl SoftSide {
             return 1.0;
         }
         let w = self.half_width.max(f64::MIN_POSITIVE);
-        let shift: f64 = std::env::var("KSHIFT").ok().and_then(|x| x.parse().ok()).unwrap_or(0.0);
-        let scale: f64 = std::env::var("KSCALE").ok().and_then(|x| x.parse().ok()).unwrap_or(1.0);
-        beta((shift + (other - nearest(&self.own_bones)) / (scale * w)).clamp(0.0, 1.0))
+        beta((1.0 - (nearest(&self.own_bones) - other) / w).clamp(0.0, 1.0))
     }
 }
 
 /// Step 3's child sides: for each soft boundary, a flood along edges from the vertices of
 /// the joint's cross-section (within the band |n·(p − o)| ≤ w and within max(D, w) of the
 /// joint), through vertices related to the boundary's region whose signed plane distance
-/// exceeds −w. A soft boundary with no cross-section (diameter 0, or no band vertex near
-/// the joint: face bones in a mouth cavity or an eye socket) is inactive: its joint gets
-/// no weight and its region's other joints keep it.
+/// exceeds −w and where κ > 0 ([`Ownership`]). A soft boundary with no
+/// cross-section (diameter 0, or no band vertex near the joint where κ > 0: face bones in
+/// a mouth cavity or an eye socket) is inactive: its joint gets no weight and its region's
+/// other joints keep it.
 fn soft_sides(
     decomposition: &Decomposition,
     skeleton: &Skeleton,
@@ -437,78 +501,63 @@ fn soft_sides(
         }
     }
     let segments = bone_segments(skeleton);
-    let bind = skeleton.bind_positions();
     d.boundaries
         .par_iter()
         .enumerate()
         .filter(|(_, b)| b.kind == BoundaryKind::Soft && b.diameter > 0.0)
         .filter_map(|(k, b)| {
-            let joint = b.joint as usize;
-            let below = |mut j: usize| loop {
-                if j == joint {
-                    break true;
+            let half_width = overlaps.half_widths[k];
+            let owner = Ownership::new(skeleton, &d.joints, &segments, b, half_width);
+            let signed = |v: usize| b.normal.dot(positions[v] - b.point);
+            let in_band_and_region = |v: usize| {
+                signed(v) > -half_width && related.row(v).iter().any(|&(r, _)| r == b.parent_region)
+            };
+            // Every vertex is examined once: κ depends on the vertex alone.
+            let words = vertex_count.div_ceil(64);
+            let (mut examined, mut reached) = (vec![0u64; words], vec![0u64; words]);
+            let mut ownership = Vec::new();
+            let mut queue = VecDeque::new();
+            let mut visit = |v: u32, queue: &mut VecDeque<u32>| {
+                let (word, bit) = (v as usize / 64, 1u64 << (v % 64));
+                if examined[word] & bit != 0 {
+                    return;
                 }
-                match skeleton.parent(j) {
-                    Some(p) => j = p,
-                    None => break false,
+                examined[word] |= bit;
+                if !in_band_and_region(v as usize) {
+                    return;
+                }
+                let kappa = owner.at(positions[v as usize]);
+                if kappa > 0.0 {
+                    reached[word] |= bit;
+                    ownership.push((v, kappa));
+                    queue.push_back(v);
                 }
             };
-            let upper_bone = |j: usize, end: DVec3| {
-                skeleton.parent(joint) == Some(j) && end == bind[joint].as_dvec3()
-            };
-            let (own, other): (Vec<_>, Vec<_>) = segments
-                .iter()
-                .filter(|&&(j, _, end)| {
-                    let j = j as usize;
-                    below(j)
-                        || (d.joints[j].region == Some(b.parent_region) && !upper_bone(j, end))
-                })
-                .partition(|&&(j, _, _)| below(j as usize));
-            let mut side = SoftSide {
+            let seed_radius = b.diameter.max(half_width);
+            for &v in &region_vertices[b.parent_region as usize] {
+                let p = positions[v as usize];
+                if p.distance(b.point) <= seed_radius && signed(v as usize) <= half_width {
+                    visit(v, &mut queue);
+                }
+            }
+            if queue.is_empty() {
+                return None;
+            }
+            while let Some(v) = queue.pop_front() {
+                for &u in d.topology.neighbors(v as usize) {
+                    visit(u, &mut queue);
+                }
+            }
+            ownership.sort_unstable_by_key(|&(v, _)| v);
+            Some(SoftSide {
                 joint: b.joint,
                 region: b.parent_region,
                 point: b.point,
                 normal: b.normal,
-                half_width: overlaps.half_widths[k],
-                own_bones: own.iter().map(|&&(_, a, e)| (a, e)).collect(),
-                other_bones: other.iter().map(|&&(_, a, e)| (a, e)).collect(),
-                reached: Vec::new(),
-            };
-            let half_width = side.half_width;
-            let signed = |v: usize| b.normal.dot(positions[v] - b.point);
-            let in_domain = |v: usize| {
-                signed(v) > -half_width
-                    && related.row(v).iter().any(|&(r, _)| r == b.parent_region)
-                    && side.ownership(positions[v]) > 0.0
-            };
-            let seed_radius = b.diameter.max(half_width);
-            let candidates = &region_vertices[b.parent_region as usize];
-            let seeds: Vec<u32> = candidates
-                .iter()
-                .filter(|&&v| positions[v as usize].distance(b.point) <= seed_radius)
-                .filter(|&&v| signed(v as usize) <= half_width && in_domain(v as usize))
-                .copied()
-                .collect();
-            if seeds.is_empty() {
-                return None;
-            }
-            let mut reached = vec![0u64; vertex_count.div_ceil(64)];
-            let mut queue = VecDeque::new();
-            for v in seeds {
-                reached[v as usize / 64] |= 1 << (v % 64);
-                queue.push_back(v);
-            }
-            while let Some(v) = queue.pop_front() {
-                for &u in d.topology.neighbors(v as usize) {
-                    let (word, bit) = (u as usize / 64, 1u64 << (u % 64));
-                    if reached[word] & bit == 0 && in_domain(u as usize) {
-                        reached[word] |= bit;
-                        queue.push_back(u);
-                    }
-                }
-            }
-            side.reached = reached;
-            Some(side)
+                half_width,
+                reached,
+                ownership,
+            })
         })
         .collect()
 }

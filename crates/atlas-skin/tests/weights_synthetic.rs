@@ -566,3 +566,60 @@ fn vertices_no_region_with_joints_reaches_take_the_nearest_weights() {
     let middle = nearest_vertex(&mesh, DVec3::new(3.0, 9.0, 0.0));
     assert!(weights.row(middle).all(|(j, _)| j == 0 || j == 2));
 }
+
+/// A straight tube along x from 0 to 12 (radius 1), one region, and a fork at its root:
+/// joint a (bone 2 → 5) has a soft boundary whose plane (normal +x at x = 2) puts the
+/// whole rest of the tube on its child side, where a sibling branch b (bone 9 → 11) lies.
+fn fork_in_one_region() -> (SurfaceMesh, Skeleton, Decomposition) {
+    let ends = [DVec3::ZERO, DVec3::new(12.0, 0.0, 0.0)];
+    let (mesh, _) = capsule_chain(&ends, &[], 1.0, SIDES, 48);
+    let positions = [0.0f32, 2.0, 5.0, 9.0, 11.0].map(|x| Vec3::new(x, 0.0, 0.0));
+    let skeleton = Skeleton::from_positions(
+        ["root", "a", "a_end", "b", "b_end"]
+            .map(String::from)
+            .to_vec(),
+        vec![NO_PARENT, 0, 1, 0, 3],
+        &positions,
+    )
+    .expect("skeleton");
+    let soft = Plane {
+        joint: 1,
+        point: DVec3::new(2.0, 0.0, 0.0),
+        normal: DVec3::X,
+    };
+    let decomposition = decompose_by_hand(&mesh, &skeleton, &[], &[(soft, 2.0)], 1.0, SIDES);
+    assert_eq!(decomposition.regions.len(), 1);
+    (mesh, skeleton, decomposition)
+}
+
+#[test]
+fn a_soft_boundary_stays_on_the_part_nearest_its_own_bones() {
+    let (mesh, skeleton, mut decomposition) = fork_in_one_region();
+    let far_end = nearest_vertex(&mesh, DVec3::new(12.0, 1.0, 0.0));
+    let own_part = nearest_vertex(&mesh, DVec3::new(4.0, 1.0, 0.0));
+    // Without the joints' regions the boundary knows no other bone: its child side is the
+    // whole tube past the plane, branch b's part included.
+    let unbounded = weights_of(&decomposition, &skeleton, Blend::PartitionOfUnity);
+    assert_eq!(weight(&unbounded, far_end, 1), 1.0);
+    for decision in &mut decomposition.joints {
+        decision.region = Some(0);
+    }
+    let weights = weights_of(&decomposition, &skeleton, Blend::PartitionOfUnity);
+    assert_partition_of_unity(&weights);
+    assert_eq!(weight(&weights, own_part, 1), 1.0);
+    let mut on_branch_b = 0;
+    for (v, p) in mesh.positions.iter().enumerate() {
+        if p.x >= 10.0 {
+            on_branch_b += 1;
+            assert_eq!(weight(&weights, v, 1), 0.0, "weight of a at {p}");
+        }
+    }
+    assert!(on_branch_b > 100);
+    // Between the parts a's weight falls without a jump between neighbours.
+    for v in 0..mesh.vertex_count() {
+        for &u in decomposition.topology.neighbors(v) {
+            let step = (weight(&weights, v, 1) - weight(&weights, u as usize, 1)).abs();
+            assert!(step < 0.5, "a's weight jumps by {step} from {v} to {u}");
+        }
+    }
+}
