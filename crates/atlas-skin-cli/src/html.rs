@@ -12,7 +12,6 @@
 
 use anyhow::{bail, Context};
 use base64::Engine;
-use std::io::Write;
 use std::path::Path;
 
 /// The page around the model; `@@NAME@@` markers are filled by [`fill_template`].
@@ -60,7 +59,7 @@ pub fn write_html(
             ("VIEWER_JS", VIEWER_JS),
         ],
     )?;
-    write_atomically(out, page.as_bytes())
+    Ok(atlas_skin_io::write_atomically(out, None, page.as_bytes())?)
 }
 
 /// Checks the 12-byte GLB header: magic, version 2 and a declared length equal to the data's.
@@ -157,28 +156,6 @@ fn escape_html(text: &str) -> String {
 
 /// Writes `bytes` to a temporary file in `out`'s folder, then renames it to `out`; on error
 /// the temporary file is removed.
-fn write_atomically(out: &Path, bytes: &[u8]) -> anyhow::Result<()> {
-    let file_name = out
-        .file_name()
-        .with_context(|| format!("{} is not a file path", out.display()))?;
-    let mut temporary_name = std::ffi::OsString::from(".");
-    temporary_name.push(file_name);
-    temporary_name.push(format!(".{}.tmp", std::process::id()));
-    let temporary = out.with_file_name(temporary_name);
-    let result = std::fs::File::create(&temporary)
-        .and_then(|mut file| {
-            file.write_all(bytes)?;
-            file.sync_all()
-        })
-        .and_then(|()| std::fs::rename(&temporary, out));
-    if let Err(error) = result {
-        // Best effort: the temporary file may not exist if creating it failed.
-        let _ = std::fs::remove_file(&temporary);
-        return Err(error).with_context(|| format!("writing {}", out.display()));
-    }
-    Ok(())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -395,14 +395,18 @@ fn failed_writes_leave_nothing_behind() {
     let bad_joint =
         VertexWeights::from_rows(vec![vec![(9u32, 1.0f32)]; character.mesh.positions.len()]);
     assert!(write_skinned_glb(&character, &bad_joint, &options, &out).is_err());
-    let missing_folder = dir.join("no such folder").join("out.glb");
-    let error = write_skinned_glb(&character, &weights, &options, &missing_folder).unwrap_err();
+    // A missing output folder is created, but not below a file.
+    let below_a_file = input.join("out.glb");
+    let error = write_skinned_glb(&character, &weights, &options, &below_a_file).unwrap_err();
     assert!(matches!(error, IoError::Write { .. }), "{error}");
     let left: Vec<_> = std::fs::read_dir(&dir)
         .unwrap()
         .map(|e| e.unwrap().file_name())
         .collect();
     assert_eq!(left, vec![std::ffi::OsString::from("RiggedSimple.glb")]);
+    let in_new_folder = dir.join("new folder").join("out.glb");
+    write_skinned_glb(&character, &weights, &options, &in_new_folder).unwrap();
+    assert!(in_new_folder.is_file());
 }
 
 /// Two primitives sharing SimpleSkin's POSITION accessor share their vertices in the

@@ -20,6 +20,7 @@
 
 use crate::decompose::DecomposeParams;
 use crate::joint_roles::JointFrame;
+use crate::nearest_bone::point_segment_distance;
 use crate::plane_section::{closed_length, polygon_contains, Plane, SectionCurve, SectionDomain};
 use crate::proximity::FaceSpheres;
 use crate::{SurfaceMesh, Topology};
@@ -80,7 +81,7 @@ pub fn find_cut_candidates(
         let everything = faces.len() == surface.mesh.triangle_count();
         let near_bones: Vec<[DVec3; 2]> = other_bones
             .iter()
-            .filter(|[a, b]| segment_distance(frame.position, *a, *b) <= 2.0 * radius)
+            .filter(|[a, b]| point_segment_distance(frame.position, *a, *b) <= 2.0 * radius)
             .copied()
             .collect();
         let search = search_within(surface, frame, &near_bones, faces);
@@ -291,13 +292,6 @@ impl PlaneSearch<'_> {
         }
         best
     }
-}
-
-/// Distance from `p` to the segment ab.
-fn segment_distance(p: DVec3, a: DVec3, b: DVec3) -> f64 {
-    let ab = b - a;
-    let t = (p - a).dot(ab) / ab.length_squared().max(f64::MIN_POSITIVE);
-    p.distance(a + ab * t.clamp(0.0, 1.0))
 }
 
 #[cfg(test)]

@@ -347,14 +347,7 @@ fn is_inside_by_rays(
 /// +1 for an outward-oriented closed surface, −1 for an inward one, 0 when the signed
 /// volume Σ a · (b × c) / 6 is negligible (open strips): ray hits are then not filtered.
 fn orientation_sign(mesh: &SurfaceMesh) -> f64 {
-    let volume: f64 = mesh
-        .triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
-            a.dot(b.cross(c)) / 6.0
-        })
-        .sum();
+    let volume = mesh.signed_volume();
     if volume.abs() <= 1e-9 * mesh.diagonal().powi(3) {
         0.0
     } else {

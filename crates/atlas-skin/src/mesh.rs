@@ -46,6 +46,18 @@ impl SurfaceMesh {
         (b - a).cross(c - a)
     }
 
+    /// Signed enclosed volume V = Σ_f a·(b × c) / 6 over the triangles' corners a, b, c:
+    /// positive for a closed outward-oriented surface (divergence theorem).
+    pub fn signed_volume(&self) -> f64 {
+        self.triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|v| self.positions[v as usize]);
+                a.dot(b.cross(c)) / 6.0
+            })
+            .sum()
+    }
+
     /// Area of triangle `f`.
     pub fn triangle_area(&self, f: usize) -> f64 {
         0.5 * self.scaled_normal(f).length()

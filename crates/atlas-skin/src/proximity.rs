@@ -7,6 +7,7 @@
 //! test runs only on faces whose sphere passes.
 //! The decomposition asks them once per joint, never once per candidate plane.
 
+use crate::nearest_bone::point_segment_distance;
 use crate::SurfaceMesh;
 use glam::{DVec3, IVec3};
 use rayon::slice::ParallelSliceMut;
@@ -467,9 +468,9 @@ pub fn point_triangle_distance(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
     let (ab, ac, ap) = (b - a, c - a, p - a);
     let normal = ab.cross(ac);
     if normal.length_squared() <= 1e-300 {
-        return segment_distance(p, a, b)
-            .min(segment_distance(p, b, c))
-            .min(segment_distance(p, c, a));
+        return point_segment_distance(p, a, b)
+            .min(point_segment_distance(p, b, c))
+            .min(point_segment_distance(p, c, a));
     }
     let (d1, d2) = (ab.dot(ap), ac.dot(ap));
     if d1 <= 0.0 && d2 <= 0.0 {
@@ -498,16 +499,6 @@ pub fn point_triangle_distance(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
         return p.distance(b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))));
     }
     (ap.dot(normal)).abs() / normal.length()
-}
-
-fn segment_distance(p: DVec3, a: DVec3, b: DVec3) -> f64 {
-    let ab = b - a;
-    let t = if ab.length_squared() > 0.0 {
-        ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    p.distance(a + ab * t)
 }
 
 #[cfg(test)]

@@ -127,15 +127,14 @@ pub fn run(args: Args) -> Result<()> {
         max_influences: params.max_influences,
         ..WriteOptions::default()
     };
-    write_skinned_glb(&character, &skinned.weights, &options, &args.output)
-        .with_context(|| format!("cannot write {}", args.output.display()))?;
+    write_skinned_glb(&character, &skinned.weights, &options, &args.output)?;
     timings.insert("write".into(), ms(start));
     progress.finish_and_clear();
 
     let report = report(&character, &welded.welded_of_stored, &skinned, timings);
     if let Some(path) = &args.report {
         let text = serde_json::to_string_pretty(&report)?;
-        std::fs::write(path, text).with_context(|| format!("cannot write {}", path.display()))?;
+        atlas_skin_io::write_atomically(path, Some(&character.path), text.as_bytes())?;
     }
     if let Some(path) = &args.debug_glb {
         write_debug(&skinned, path)?;
@@ -143,8 +142,7 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(path) = &args.html {
         let glb = std::fs::read(&args.output)
             .with_context(|| format!("cannot read back {}", args.output.display()))?;
-        crate::html::write_html(&glb, Some(&report), path)
-            .with_context(|| format!("cannot write {}", path.display()))?;
+        crate::html::write_html(&glb, Some(&report), path)?;
     }
     let d = skinned.decomposition.report();
     println!(

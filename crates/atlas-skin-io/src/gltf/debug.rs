@@ -2,7 +2,7 @@
 //! (regions, weights) and line segments (cut curves, bones).
 
 use super::builder::{index_component, GlbBuilder, ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER};
-use super::output::write_atomically;
+use crate::output::write_atomically;
 use crate::IoError;
 use glam::Vec3;
 use serde_json::{json, Map};

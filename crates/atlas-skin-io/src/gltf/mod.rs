@@ -13,7 +13,6 @@ mod debug;
 mod document;
 mod new_document;
 mod nodes;
-mod output;
 mod prune;
 mod read;
 mod rewrite;

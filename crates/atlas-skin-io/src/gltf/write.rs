@@ -4,8 +4,8 @@
 use super::accessor::ComponentType;
 use super::builder::{GlbBuilder, ARRAY_BUFFER};
 use super::new_document::new_document;
-use super::output::write_atomically;
 use super::rewrite::rewrite_document;
+use crate::output::write_atomically;
 use crate::{Character, IoError};
 use atlas_skin_runtime::{Clip, VertexWeights};
 use serde_json::{Map, Value};

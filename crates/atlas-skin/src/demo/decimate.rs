@@ -155,17 +155,12 @@ pub fn collapse_shortest_edges(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::demo::marching_tetrahedra::{extract, Grid};
+    use crate::demo::marching_tetrahedra::fixtures::{assert_closed_sphere, unit_sphere};
     use crate::{MeshStats, SurfaceMesh, Topology};
 
     #[test]
     fn coarsened_sphere_stays_a_closed_sphere() {
-        let grid = Grid {
-            origin: DVec3::splat(-1.2),
-            step: 0.08,
-            counts: [31, 31, 31],
-        };
-        let (positions, triangles) = extract(&grid, |p| p.length() - 1.0);
+        let (positions, triangles) = unit_sphere(0.08);
         let (positions, triangles) =
             collapse_shortest_edges(&positions, &triangles, 500, |p| p.normalize());
         assert_eq!(positions.len(), 500);
@@ -173,10 +168,8 @@ mod tests {
             positions,
             triangles,
         };
+        assert_closed_sphere(&mesh);
         let stats = MeshStats::new(&mesh, &Topology::new(&mesh));
-        assert!(stats.closed);
-        assert_eq!(stats.genus, Some(0));
-        assert_eq!(stats.inconsistently_oriented_edges, 0);
         assert_eq!(stats.degenerate_triangles, 0);
     }
 }

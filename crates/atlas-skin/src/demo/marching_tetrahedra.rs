@@ -173,28 +173,48 @@ fn orient_consistently(positions: &[DVec3], triangles: &mut [[u32; 3]]) {
     }
 }
 
+/// Test fixtures shared by the demo's tests.
 #[cfg(test)]
-mod tests {
-    use super::*;
+pub(crate) mod fixtures {
+    use super::{extract, Grid};
     use crate::{MeshStats, SurfaceMesh, Topology};
+    use glam::DVec3;
 
-    #[test]
-    fn sphere_is_closed_genus_zero_and_outward() {
+    /// The unit sphere by marching tetrahedra on a grid of spacing `step` around it.
+    pub fn unit_sphere(step: f64) -> (Vec<DVec3>, Vec<[u32; 3]>) {
+        let count = (2.6 / step).ceil() as usize + 1;
         let grid = Grid {
             origin: DVec3::splat(-1.3),
-            step: 0.1,
-            counts: [27, 27, 27],
+            step,
+            counts: [count; 3],
         };
-        let (positions, triangles) = extract(&grid, |p| p.length() - 1.0);
-        let mesh = SurfaceMesh {
-            positions,
-            triangles,
-        };
-        let stats = MeshStats::new(&mesh, &Topology::new(&mesh));
+        extract(&grid, |p| p.length() - 1.0)
+    }
+
+    /// Asserts that the surface is one closed, consistently oriented sphere.
+    pub fn assert_closed_sphere(mesh: &SurfaceMesh) {
+        let stats = MeshStats::new(mesh, &Topology::new(mesh));
         assert!(stats.closed);
         assert_eq!(stats.genus, Some(0));
         assert_eq!(stats.components, 1);
         assert_eq!(stats.inconsistently_oriented_edges, 0);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fixtures::{assert_closed_sphere, unit_sphere};
+    use crate::SurfaceMesh;
+    use glam::DVec3;
+
+    #[test]
+    fn sphere_is_closed_genus_zero_and_outward() {
+        let (positions, triangles) = unit_sphere(0.1);
+        let mesh = SurfaceMesh {
+            positions,
+            triangles,
+        };
+        assert_closed_sphere(&mesh);
         assert!(crate::winding::winding_number(&mesh, DVec3::ZERO) > 0.99);
         for p in &mesh.positions {
             assert!((p.length() - 1.0).abs() < 0.02);

@@ -5,17 +5,13 @@ use std::path::Path;
 
 /// Writes `bytes` to `out` through a temporary file in the same folder that is then renamed
 /// into place, so `out` is either complete or untouched; the temporary file is removed on
-/// error.
+/// error. A missing output folder is created.
 ///
 /// # Errors
 /// [`IoError::WouldOverwriteInput`] when `out` is the file `input` (same path after
 /// resolving links), [`IoError::IsDirectory`] when `out` is a folder, [`IoError::Write`]
 /// when the file cannot be written.
-pub(crate) fn write_atomically(
-    out: &Path,
-    input: Option<&Path>,
-    bytes: &[u8],
-) -> Result<(), IoError> {
+pub fn write_atomically(out: &Path, input: Option<&Path>, bytes: &[u8]) -> Result<(), IoError> {
     if input.is_some_and(|input| is_same_file(out, input)) {
         return Err(IoError::WouldOverwriteInput {
             path: out.to_path_buf(),
@@ -33,6 +29,9 @@ pub(crate) fn write_atomically(
     let name = out
         .file_name()
         .ok_or_else(|| write_error(std::io::Error::other("the path has no file name")))?;
+    if let Some(folder) = out.parent().filter(|f| !f.as_os_str().is_empty()) {
+        std::fs::create_dir_all(folder).map_err(write_error)?;
+    }
     let temporary = out.with_file_name(format!(
         ".{}.{}.tmp",
         name.to_string_lossy(),
