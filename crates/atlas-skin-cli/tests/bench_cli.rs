@@ -3,41 +3,14 @@
 
 use atlas_skin::demo::{demo_character, DEFAULT_STEP};
 use serde_json::Value;
-use std::path::{Path, PathBuf};
-use std::process::Command;
 
+mod support;
+
+use support::{atlas_skin_ok, obj_positions, test_file};
+
+/// Runs `atlas-skin ARGS...`, which must succeed, and returns its standard output.
 fn atlas_skin(args: &[&str]) -> String {
-    let output = Command::new(env!("CARGO_BIN_EXE_atlas-skin"))
-        .args(args)
-        .output()
-        .expect("run atlas-skin");
-    assert!(
-        output.status.success(),
-        "atlas-skin {args:?} failed: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    String::from_utf8(output.stdout).expect("UTF-8 output")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("atlas-skin-bench-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temporary directory");
-    dir.join(name)
-}
-
-fn obj_positions(path: &Path) -> Vec<[f32; 3]> {
-    std::fs::read_to_string(path)
-        .expect("OBJ written")
-        .lines()
-        .filter_map(|l| l.strip_prefix("v "))
-        .map(|l| {
-            let v: Vec<f32> = l
-                .split_whitespace()
-                .map(|x| x.parse().expect("a number"))
-                .collect();
-            [v[0], v[1], v[2]]
-        })
-        .collect()
+    String::from_utf8(atlas_skin_ok(args).stdout).expect("UTF-8 output")
 }
 
 fn bench_json(threads: &str) -> Value {
@@ -95,10 +68,10 @@ fn pose_runs_on_the_demo_character() {
         |(lo, hi), &p| (lo.min(p), hi.max(p)),
     );
     let diagonal = (max - min).length();
-    let empty = scratch("empty.json");
+    let empty = test_file("bench_cli", "empty.json");
     std::fs::write(&empty, "{}").expect("pose file written");
-    let rest = scratch("rest.obj");
-    let random = scratch("random.obj");
+    let rest = test_file("bench_cli", "rest.obj");
+    let random = test_file("bench_cli", "random.obj");
     for (source, out) in [
         (["--pose", empty.to_str().expect("UTF-8 path")], &rest),
         (["--random", "5"], &random),

@@ -3,7 +3,18 @@
 
 use glam::Vec3;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
+
+mod support;
+
+use support::{atlas_skin, obj_positions, test_file};
+
+/// Runs `atlas-skin pose ARGS...`.
+fn pose(args: &[&str]) -> Output {
+    let mut all = vec!["pose"];
+    all.extend_from_slice(args);
+    atlas_skin(&all)
+}
 
 const MODELS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/models");
 const MOTION: &str = concat!(
@@ -17,43 +28,17 @@ fn model(folder: &str, file: &str) -> PathBuf {
     path
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("atlas-skin-pose-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temporary directory");
-    dir.join(name)
-}
-
-fn pose(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_atlas-skin"))
-        .arg("pose")
-        .args(args)
-        .output()
-        .expect("run atlas-skin")
-}
-
-fn obj_positions(path: &Path) -> Vec<[f32; 3]> {
-    std::fs::read_to_string(path)
-        .expect("OBJ written")
-        .lines()
-        .filter_map(|l| l.strip_prefix("v "))
-        .map(|l| {
-            let v: Vec<f32> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
-            [v[0], v[1], v[2]]
-        })
-        .collect()
-}
-
 /// An empty pose file is the rest pose: on the arm (skeleton in its bind pose, weights
 /// summing to 1) the output is the input mesh, with both methods, up to the round-off of
 /// composing the joint hierarchy (world · inverse bind is the identity only to ~1 ulp).
 #[test]
 fn rest_pose_gives_the_rest_mesh() {
     let dir = Path::new(MODELS).join("arm");
-    let empty = scratch("empty.json");
+    let empty = test_file("pose_cli", "empty.json");
     std::fs::write(&empty, "{}").unwrap();
     let input = atlas_skin_io::obj::read(&dir.join("arm.obj"), None).expect("read arm");
     for dqs in [false, true] {
-        let out = scratch(&format!("arm-rest-{dqs}.obj"));
+        let out = test_file("pose_cli", &format!("arm-rest-{dqs}.obj"));
         let mut args = vec![
             dir.join("arm.obj").to_str().unwrap().to_string(),
             "--skeleton".into(),
@@ -99,7 +84,7 @@ fn every_pose_source_writes_obj_and_glb() {
     .enumerate()
     {
         for extension in ["obj", "glb"] {
-            let out = scratch(&format!("cesium-{i}.{extension}"));
+            let out = test_file("pose_cli", &format!("cesium-{i}.{extension}"));
             let mut args = vec![input];
             args.extend(source.iter().copied());
             args.extend(["-o", out.to_str().unwrap()]);
@@ -114,7 +99,7 @@ fn every_pose_source_writes_obj_and_glb() {
     }
     // Same seed, same pose; another seed, another pose.
     let out = |seed: &str, name: &str| {
-        let path = scratch(name);
+        let path = test_file("pose_cli", name);
         assert!(
             pose(&[input, "--random", seed, "-o", path.to_str().unwrap()])
                 .status
@@ -130,12 +115,12 @@ fn every_pose_source_writes_obj_and_glb() {
 fn invalid_invocations_fail_with_a_message() {
     let cesium = model("cesiumman", "CesiumMan.glb");
     let cesium = cesium.to_str().unwrap();
-    let unknown_joint = scratch("unknown-joint.json");
+    let unknown_joint = test_file("pose_cli", "unknown-joint.json");
     std::fs::write(&unknown_joint, r#"{"no such joint": [0, 0, 0, 1]}"#).unwrap();
-    let not_json = scratch("not.json");
+    let not_json = test_file("pose_cli", "not.json");
     std::fs::write(&not_json, "{").unwrap();
     let arm = model("arm", "arm.obj");
-    let out = scratch("never.obj");
+    let out = test_file("pose_cli", "never.obj");
     let out = out.to_str().unwrap();
     let cases: Vec<(Vec<&str>, &str)> = vec![
         (vec![cesium, "-o", out], "required"),

@@ -7,7 +7,7 @@ mod support;
 use atlas_skin_corpus::{node_json, Model, CESIUMMAN, RIGGEDFIGURE, RIGGEDSIMPLE};
 use std::ffi::OsStr;
 use std::path::Path;
-use support::{atlas_skin_ok, out_dir};
+use support::{atlas_skin_ok, obj_positions, out_dir};
 
 /// (model, joints turned by the pose file)
 const CORPUS: [(Model, &[&str]); 3] = [
@@ -22,16 +22,9 @@ fn atlas_pose(input: &Path, args: &[&str], out: &Path) -> Vec<[f64; 3]> {
     all.extend(args.iter().map(OsStr::new));
     all.extend([OsStr::new("-o"), out.as_os_str()]);
     atlas_skin_ok(&all);
-    let text = std::fs::read_to_string(out).expect("pose wrote the OBJ");
-    text.lines()
-        .filter_map(|l| l.strip_prefix("v "))
-        .map(|l| {
-            let v: Vec<f64> = l
-                .split_whitespace()
-                .map(|x| x.parse().expect("number"))
-                .collect();
-            [v[0], v[1], v[2]]
-        })
+    obj_positions(out)
+        .into_iter()
+        .map(|p| p.map(f64::from))
         .collect()
 }
 

@@ -1,5 +1,5 @@
 //! Shared helpers of the CLI's integration tests (`mod support;`): running the
-//! `atlas-skin` binary and a fresh output folder per test. The corpus and the node
+//! `atlas-skin` binary, a fresh output folder per test, reading back an OBJ it wrote. The corpus and the node
 //! checkers of tests/js are in the `atlas-skin-corpus` crate.
 
 #![allow(dead_code)] // each test binary uses a subset
@@ -37,4 +37,31 @@ pub fn out_dir(test: &str) -> PathBuf {
     std::fs::create_dir_all(&dir)
         .unwrap_or_else(|e| panic!("cannot create {}: {e}", dir.display()));
     dir
+}
+
+/// A path for file `name` in test `test`'s output folder, created if missing but never
+/// emptied (several tests of one binary may share it while running in parallel).
+pub fn test_file(test: &str, name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("cli_tests")
+        .join(test);
+    std::fs::create_dir_all(&dir)
+        .unwrap_or_else(|e| panic!("cannot create {}: {e}", dir.display()));
+    dir.join(name)
+}
+
+/// Vertex positions (`v x y z` lines) of an OBJ file the binary wrote.
+pub fn obj_positions(path: &Path) -> Vec<[f32; 3]> {
+    let text = std::fs::read_to_string(path)
+        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
+    text.lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            let v: Vec<f32> = l
+                .split_whitespace()
+                .map(|x| x.parse().expect("a number"))
+                .collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect()
 }
