@@ -114,6 +114,26 @@ impl GlbBuilder {
         )
     }
 
+    /// Appends mesh geometry: `positions` as a VEC3 float accessor with bounds and
+    /// `triangles` as an index accessor of the smallest allowed type. Returns (position
+    /// accessor, index accessor).
+    pub fn push_triangle_mesh(
+        &mut self,
+        positions: &[glam::Vec3],
+        triangles: &[[u32; 3]],
+    ) -> (usize, usize) {
+        let flat: Vec<f32> = positions.iter().flat_map(|p| p.to_array()).collect();
+        let position = self.push_f32_accessor(&flat, "VEC3", true, Some(ARRAY_BUFFER));
+        let flat_indices: Vec<u32> = triangles.iter().flatten().copied().collect();
+        let indices = self.push_uint_accessor(
+            &flat_indices,
+            index_component(positions.len()),
+            "SCALAR",
+            Some(ELEMENT_ARRAY_BUFFER),
+        );
+        (position, indices)
+    }
+
     /// Appends unsigned integer `values` (flattened elements of `type_name`) stored as
     /// `component` (U8, U16 or U32; every value must fit).
     pub fn push_uint_accessor(
@@ -188,7 +208,7 @@ fn component_bounds(values: &[f32], components: usize) -> (Vec<f32>, Vec<f32>) {
 }
 
 /// The smallest index component type for vertex indices below `vertex_count`.
-pub(crate) fn index_component(vertex_count: usize) -> ComponentType {
+fn index_component(vertex_count: usize) -> ComponentType {
     // 65535 is the primitive-restart value of UNSIGNED_SHORT and may not be used.
     if vertex_count <= 65535 {
         ComponentType::U16

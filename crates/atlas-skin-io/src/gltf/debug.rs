@@ -1,7 +1,7 @@
 //! An unskinned `.glb` for looking at intermediate results: a mesh coloured per vertex
 //! (regions, weights) and line segments (cut curves, bones).
 
-use super::builder::{index_component, GlbBuilder, ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER};
+use super::builder::{GlbBuilder, ARRAY_BUFFER};
 use crate::output::write_atomically;
 use crate::IoError;
 use glam::Vec3;
@@ -71,15 +71,7 @@ pub fn write_debug_glb(
     );
     let mut primitives = Vec::new();
     if !triangles.is_empty() {
-        let flat: Vec<f32> = positions.iter().flat_map(|p| p.to_array()).collect();
-        let position = builder.push_f32_accessor(&flat, "VEC3", true, Some(ARRAY_BUFFER));
-        let flat_indices: Vec<u32> = triangles.iter().flatten().copied().collect();
-        let indices = builder.push_uint_accessor(
-            &flat_indices,
-            index_component(positions.len()),
-            "SCALAR",
-            Some(ELEMENT_ARRAY_BUFFER),
-        );
+        let (position, indices) = builder.push_triangle_mesh(positions, triangles);
         let mut attributes = json!({"POSITION": position});
         if !vertex_colors.is_empty() {
             let colors: Vec<f32> = vertex_colors.iter().flatten().copied().collect();

@@ -1,7 +1,7 @@
 //! A new skinned glTF document for a character that was not read from glTF.
 
 use super::animation::append_clips;
-use super::builder::{index_component, GlbBuilder, ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER};
+use super::builder::{GlbBuilder, ARRAY_BUFFER};
 use super::write::{merge_asset_extras, pack_weights, push_weight_accessors, WriteOptions};
 use crate::{Character, IoError};
 use atlas_skin_runtime::{Skeleton, VertexWeights};
@@ -60,16 +60,9 @@ pub(crate) fn new_document(
     );
     let flat =
         |vectors: &[Vec3]| -> Vec<f32> { vectors.iter().flat_map(|p| p.to_array()).collect() };
-    let position = builder.push_f32_accessor(&flat(&positions), "VEC3", true, Some(ARRAY_BUFFER));
+    let (position, indices) = builder.push_triangle_mesh(&positions, &triangles);
     let normals = smooth_normals(&positions, &triangles);
     let normal = builder.push_f32_accessor(&flat(&normals), "VEC3", false, Some(ARRAY_BUFFER));
-    let flat_indices: Vec<u32> = triangles.iter().flatten().copied().collect();
-    let indices = builder.push_uint_accessor(
-        &flat_indices,
-        index_component(positions.len()),
-        "SCALAR",
-        Some(ELEMENT_ARRAY_BUFFER),
-    );
     let packed = pack_weights(weights, kept.iter().copied(), options.max_influences);
     let sets = push_weight_accessors(&mut builder, &packed, skeleton.len());
     let mut attributes = json!({"POSITION": position, "NORMAL": normal});
