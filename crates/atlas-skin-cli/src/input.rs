@@ -5,12 +5,9 @@ use atlas_skin::{weld, MeshStats, Topology, Welded};
 use atlas_skin_io::{Character, LoadOptions, TriangleMesh};
 use std::path::PathBuf;
 
-/// Where the character comes from.
-#[derive(clap::Args, Debug, Clone)]
-pub struct InputArgs {
-    /// The character: .glb/.gltf/.vrm (mesh and skeleton), or a mesh (.obj, .mesh, .off,
-    /// .ply, .stl) with --skeleton. Without it: the built-in demo character.
-    pub input: Option<PathBuf>,
+/// How to read a character's files, besides its main file.
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct ReadArgs {
     /// Skeleton file for a mesh without one: .tgf, .bvh, .mhskel or .json.
     #[arg(long)]
     pub skeleton: Option<PathBuf>,
@@ -22,7 +19,7 @@ pub struct InputArgs {
     pub weights: Option<PathBuf>,
 }
 
-impl InputArgs {
+impl ReadArgs {
     pub fn load_options(&self) -> LoadOptions {
         LoadOptions {
             skeleton: self.skeleton.clone(),
@@ -30,12 +27,27 @@ impl InputArgs {
             weights: self.weights.clone(),
         }
     }
+}
 
+/// Where the character comes from.
+#[derive(clap::Args, Debug, Clone)]
+pub struct InputArgs {
+    /// The character: .glb/.gltf/.vrm (mesh and skeleton), or a mesh (.obj, .mesh, .off,
+    /// .ply, .stl) with --skeleton. Without it: the built-in demo character.
+    pub input: Option<PathBuf>,
+    #[command(flatten)]
+    pub read: ReadArgs,
+}
+
+impl InputArgs {
     /// Reads the character, or builds the demo character when no input is given.
     pub fn load(&self) -> Result<Character> {
         match &self.input {
             // The reader's errors name the file already.
-            Some(path) => Ok(atlas_skin_io::load_character(path, &self.load_options())?),
+            Some(path) => Ok(atlas_skin_io::load_character(
+                path,
+                &self.read.load_options(),
+            )?),
             None => Ok(demo_character()),
         }
     }

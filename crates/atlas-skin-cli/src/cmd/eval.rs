@@ -2,7 +2,7 @@
 //! mesh: weight difference, deformation error, bleeding, validity
 //! ([`atlas_skin::eval`]).
 
-use crate::input::{InputArgs, Prepared};
+use crate::input::{InputArgs, Prepared, ReadArgs};
 use anyhow::{Context, Result};
 use atlas_skin::eval::{evaluate, Animation, EvalInput, EvalOptions, Evaluation, Weighted};
 use atlas_skin_io::{Character, LoadOptions};
@@ -17,15 +17,9 @@ pub struct Args {
     /// The candidate: a skinned .glb/.gltf of the same mesh, joints named as the
     /// reference's.
     pub candidate: PathBuf,
-    /// Skeleton file for a reference mesh without one: .tgf, .bvh, .mhskel or .json.
-    #[arg(long)]
-    pub skeleton: Option<PathBuf>,
-    /// Use only the faces of this OBJ group of the reference (e.g. MakeHuman's `body`).
-    #[arg(long)]
-    pub group: Option<String>,
-    /// Reference weights for a mesh without them: .dmat (libigl) or .mhw (MakeHuman).
-    #[arg(long)]
-    pub weights: Option<PathBuf>,
+    /// How to read the reference (--skeleton, --group, --weights).
+    #[command(flatten)]
+    pub read: ReadArgs,
     /// Number of seeded random poses.
     #[arg(long, default_value_t = 10)]
     pub poses: usize,
@@ -47,9 +41,7 @@ pub struct Args {
 pub fn run(args: Args) -> Result<()> {
     let reference_input = InputArgs {
         input: Some(args.reference.clone()),
-        skeleton: args.skeleton.clone(),
-        group: args.group.clone(),
-        weights: args.weights.clone(),
+        read: args.read.clone(),
     };
     let reference = Prepared::new(reference_input.load()?);
     let candidate = atlas_skin_io::load_character(&args.candidate, &LoadOptions::default())
