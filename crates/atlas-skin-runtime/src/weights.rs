@@ -63,7 +63,7 @@ impl VertexWeights {
     pub fn validate(&self, joint_count: usize) -> Result<(), RuntimeError> {
         if self.offsets.first() != Some(&0)
             || self.offsets.windows(2).any(|w| w[0] > w[1])
-            || *self.offsets.last().unwrap() as usize != self.joints.len()
+            || self.offsets.last().map(|&last| last as usize) != Some(self.joints.len())
             || self.joints.len() != self.weights.len()
         {
             return Err(RuntimeError::BufferSize {
