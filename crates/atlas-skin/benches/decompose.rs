@@ -6,26 +6,18 @@
 use atlas_skin::shapes::capsule_chain;
 use atlas_skin::weld::DEFAULT_WELD_TOLERANCE;
 use atlas_skin::{decompose, weld, DecomposeParams, SurfaceMesh, Topology};
-use atlas_skin_io::{load_character, LoadOptions};
+use atlas_skin_corpus::MAKEHUMAN;
+use atlas_skin_io::load_character;
 use atlas_skin_runtime::Skeleton;
 use divan::Bencher;
 use glam::DVec3;
-use std::path::PathBuf;
 
 fn main() {
     divan::main();
 }
 
-const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data");
-
 fn makehuman_body() -> (SurfaceMesh, Skeleton) {
-    let folder = PathBuf::from(DATA).join("models/makehuman");
-    let options = LoadOptions {
-        skeleton: Some(folder.join("default.mhskel")),
-        group: Some("body".into()),
-        ..Default::default()
-    };
-    let character = load_character(&folder.join("base.obj"), &options)
+    let character = load_character(&MAKEHUMAN.input_path(), &MAKEHUMAN.load_options(false))
         .unwrap_or_else(|e| panic!("the corpus is needed for this benchmark: {e}"));
     let welded = weld(
         &character.mesh.positions,

@@ -9,14 +9,12 @@
 use atlas_skin::pipeline::{skin, SkinParams};
 use atlas_skin::weld::DEFAULT_WELD_TOLERANCE;
 use atlas_skin::{weld, Topology, Welded};
-use atlas_skin_io::{load_character, Character, LoadOptions, TriangleMesh};
+use atlas_skin_corpus::{Model, CESIUMMAN, MAKEHUMAN};
+use atlas_skin_io::{load_character, Character, TriangleMesh};
 use atlas_skin_runtime::Skeleton;
 use divan::Bencher;
 use glam::Vec3;
 use std::collections::HashMap;
-use std::path::Path;
-
-const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/models");
 
 fn main() {
     divan::main();
@@ -30,24 +28,10 @@ fn main() {
     }
 }
 
-fn load(folder: &str, input: &str, skeleton: Option<&str>, group: Option<&str>) -> Character {
-    let folder = Path::new(DATA).join(folder);
-    let options = LoadOptions {
-        skeleton: skeleton.map(|s| folder.join(s)),
-        group: group.map(String::from),
-        weights: None,
-    };
-    load_character(&folder.join(input), &options)
+/// Reads a corpus model (mesh and skeleton, no reference weights).
+fn load(model: &Model) -> Character {
+    load_character(&model.input_path(), &model.load_options(false))
         .unwrap_or_else(|e| panic!("the corpus is needed for this benchmark: {e}"))
-}
-
-fn makehuman() -> Character {
-    load(
-        "makehuman",
-        "base.obj",
-        Some("default.mhskel"),
-        Some("body"),
-    )
 }
 
 /// Splits every triangle into four at its edge midpoints, `levels` times (the surface and
@@ -116,19 +100,19 @@ fn bench_skin(bencher: Bencher, prepared: &Prepared) {
 
 #[divan::bench(sample_count = 20)]
 fn cesiumman(bencher: Bencher) {
-    let character = load("cesiumman", "CesiumMan.glb", None, None);
+    let character = load(&CESIUMMAN);
     bench_skin(bencher, &prepare(&character.mesh, character.skeleton));
 }
 
 #[divan::bench(sample_count = 20)]
 fn makehuman_body(bencher: Bencher) {
-    let character = makehuman();
+    let character = load(&MAKEHUMAN);
     bench_skin(bencher, &prepare(&character.mesh, character.skeleton));
 }
 
 #[divan::bench(sample_count = 2, sample_size = 1)]
 fn makehuman_body_subdivided_1m(bencher: Bencher) {
-    let character = makehuman();
+    let character = load(&MAKEHUMAN);
     let mesh = subdivide(&character.mesh, 3);
     bench_skin(bencher, &prepare(&mesh, character.skeleton));
 }

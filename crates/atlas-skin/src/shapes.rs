@@ -279,22 +279,12 @@ mod tests {
     use super::*;
     use crate::{MeshStats, Topology};
 
-    fn signed_volume(mesh: &SurfaceMesh) -> f64 {
-        mesh.triangles
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
-                a.dot(b.cross(c)) / 6.0
-            })
-            .sum()
-    }
-
     fn assert_closed_sphere(mesh: &SurfaceMesh, volume: f64, tolerance: f64) {
         let stats = MeshStats::new(mesh, &Topology::new(mesh));
         assert!(stats.closed, "{stats:?}");
         assert_eq!(stats.genus, Some(0));
         assert_eq!(stats.inconsistently_oriented_edges, 0);
-        let v = signed_volume(mesh);
+        let v = mesh.signed_volume();
         assert!(
             (v - volume).abs() < tolerance * volume,
             "volume {v}, expected {volume}"

@@ -16,35 +16,16 @@ use atlas_skin::winding::winding_number;
 use atlas_skin::{
     decompose, weld, DecomposeParams, Decomposition, JointStatus, SurfaceMesh, Topology,
 };
-use atlas_skin_io::{load_character, LoadOptions};
+use atlas_skin_corpus::{
+    Model, ARM, CESIUMMAN, ELEPHANT, HAND, MAKEHUMAN, RIGGEDFIGURE, RIGGEDSIMPLE, SIMPLESKIN,
+};
+use atlas_skin_io::load_character;
 use atlas_skin_runtime::Skeleton;
 use decompose_checks::check_decomposition;
-use std::path::PathBuf;
-
-const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data");
-
-/// A corpus model: its main file, skeleton file and OBJ group when it needs them.
-struct Model {
-    folder: &'static str,
-    file: &'static str,
-    skeleton: Option<&'static str>,
-    group: Option<&'static str>,
-}
 
 fn load(model: &Model) -> (SurfaceMesh, Skeleton) {
-    let folder = PathBuf::from(DATA).join("models").join(model.folder);
-    assert!(
-        folder.is_dir(),
-        "missing corpus folder {}",
-        folder.display()
-    );
-    let options = LoadOptions {
-        skeleton: model.skeleton.map(|s| folder.join(s)),
-        group: model.group.map(str::to_string),
-        ..Default::default()
-    };
-    let character = load_character(&folder.join(model.file), &options)
-        .unwrap_or_else(|e| panic!("{}: {e}", model.folder));
+    let character = load_character(&model.input_path(), &model.load_options(false))
+        .unwrap_or_else(|e| panic!("{}: {e}", model.name));
     let welded = weld(
         &character.mesh.positions,
         &character.mesh.triangles,
@@ -76,14 +57,14 @@ fn check_closed_model(model: &Model, required: &[&str]) -> Decomposition {
     let positions = skeleton.bind_positions();
     for (j, decision) in d.joints.iter().enumerate() {
         if decision.status != JointStatus::Cut {
-            eprintln!("{}: {} {:?}", model.folder, decision.name, decision.status);
+            eprintln!("{}: {} {:?}", model.name, decision.name, decision.status);
         }
         let inside = winding_number(&mesh, positions[j].as_dvec3()).abs() > 0.5;
         if let (true, JointStatus::Skipped(reason)) = (inside, &decision.status) {
             assert!(
                 NO_GEOMETRY.iter().any(|r| reason.starts_with(r)),
                 "{}: {} is inside the mesh but has no boundary: {reason}",
-                model.folder,
+                model.name,
                 decision.name
             );
         }
@@ -93,18 +74,18 @@ fn check_closed_model(model: &Model, required: &[&str]) -> Decomposition {
             .joints
             .iter()
             .find(|j| j.name == *name)
-            .unwrap_or_else(|| panic!("{}: no joint {name}", model.folder));
+            .unwrap_or_else(|| panic!("{}: no joint {name}", model.name));
         assert_eq!(
             decision.status,
             JointStatus::Cut,
             "{}: {name} is not cut",
-            model.folder
+            model.name
         );
     }
     let report = d.report();
     eprintln!(
         "{}: {} cuts, {} soft, {} skipped, {} regions",
-        model.folder,
+        model.name,
         cuts,
         report.soft,
         report.skipped,
@@ -131,12 +112,7 @@ fn assert_bounded(d: &Decomposition, model: &str, names: &[&str]) {
 
 #[test]
 fn riggedsimple_cuts_its_leaf_joint() {
-    let model = Model {
-        folder: "riggedsimple",
-        file: "RiggedSimple.glb",
-        skeleton: None,
-        group: None,
-    };
+    let model = RIGGEDSIMPLE;
     let d = check_closed_model(&model, &["node3"]);
     assert_eq!(d.regions.len(), 2);
 }
@@ -149,23 +125,13 @@ const FIGURE_LIMB_JOINTS: [&str; 8] = [
 
 #[test]
 fn riggedfigure_cuts_every_limb_joint() {
-    let model = Model {
-        folder: "riggedfigure",
-        file: "RiggedFigure.glb",
-        skeleton: None,
-        group: None,
-    };
+    let model = RIGGEDFIGURE;
     check_closed_model(&model, &FIGURE_LIMB_JOINTS);
 }
 
 #[test]
 fn cesiumman_cuts_every_limb_joint() {
-    let model = Model {
-        folder: "cesiumman",
-        file: "CesiumMan.glb",
-        skeleton: None,
-        group: None,
-    };
+    let model = CESIUMMAN;
     let d = check_closed_model(&model, &FIGURE_LIMB_JOINTS);
     // The toes: leaves past the ball of the foot, whose bone points down into the sole.
     assert_bounded(&d, "cesiumman", &["node10", "node6"]);
@@ -173,24 +139,14 @@ fn cesiumman_cuts_every_limb_joint() {
 
 #[test]
 fn arm_cuts_its_chain() {
-    let model = Model {
-        folder: "arm",
-        file: "arm.obj",
-        skeleton: Some("arm.tgf"),
-        group: None,
-    };
+    let model = ARM;
     // Shoulder tgf_2, elbow tgf_3, wrist tgf_4 (manifest positions along +x).
     check_closed_model(&model, &["tgf_2", "tgf_3", "tgf_4"]);
 }
 
 #[test]
 fn hand_cuts_its_fingers() {
-    let model = Model {
-        folder: "hand",
-        file: "hand.mesh",
-        skeleton: Some("hand.tgf"),
-        group: None,
-    };
+    let model = HAND;
     // The wrist tgf_2 (five finger bones) and every finger joint but the tips.
     let mut required = vec!["tgf_2".to_string()];
     for first in [3, 6, 10, 14, 18] {
@@ -203,12 +159,7 @@ fn hand_cuts_its_fingers() {
 
 #[test]
 fn elephant_cuts_its_limbs() {
-    let model = Model {
-        folder: "elephant",
-        file: "elephant.obj",
-        skeleton: Some("elephant.tgf"),
-        group: None,
-    };
+    let model = ELEPHANT;
     // Elbows tgf_9/tgf_13, wrists tgf_10/tgf_14, knees tgf_17/tgf_22, ankles tgf_18/tgf_23
     // (the second and third joints of the limb chains; manifest positions).
     check_closed_model(
@@ -221,12 +172,7 @@ fn elephant_cuts_its_limbs() {
 
 #[test]
 fn makehuman_body_cuts_every_limb_joint() {
-    let model = Model {
-        folder: "makehuman",
-        file: "base.obj",
-        skeleton: Some("default.mhskel"),
-        group: Some("body"),
-    };
+    let model = MAKEHUMAN;
     let d = check_closed_model(
         &model,
         &[
@@ -246,12 +192,7 @@ fn makehuman_body_cuts_every_limb_joint() {
 
 #[test]
 fn simpleskin_open_strip_finishes_with_reasons() {
-    let model = Model {
-        folder: "simpleskin",
-        file: "SimpleSkin.gltf",
-        skeleton: None,
-        group: None,
-    };
+    let model = SIMPLESKIN;
     let (mesh, skeleton) = load(&model);
     let d = decompose(
         &mesh,
