@@ -212,4 +212,49 @@ fn swapped_joints_give_the_weight_difference_worked_out_from_the_data() {
     );
     assert!((got("max") - max).abs() < 1e-5, "{} vs {max}", got("max"));
     assert!(e["deform_random"]["mean"].as_f64().unwrap() > 1e-3);
+    assert!(e.get("worst_vertices").is_none());
+
+    // --worst lists the vertices of the largest error, worst first, with both rows.
+    let e = eval_json(model, &candidate, &["--worst", "3"]);
+    let worst = e["worst_vertices"].as_array().unwrap();
+    assert_eq!(worst.len(), 3);
+    let error = |w: &Value| w["error"].as_f64().unwrap();
+    assert_eq!(
+        error(&worst[0]),
+        e["deform_random"]["max"].as_f64().unwrap()
+    );
+    assert!(error(&worst[0]) >= error(&worst[1]) && error(&worst[1]) >= error(&worst[2]));
+    for w in worst {
+        let v = w["vertex"].as_u64().unwrap() as usize;
+        let position = character.mesh.positions[v].to_array();
+        let listed: Vec<f32> = w["position"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap() as f32)
+            .collect();
+        assert_eq!(listed, position);
+        assert!(w["pose"].as_u64().unwrap() < 10);
+        // The candidate's row is the reference's with the two joints swapped.
+        let names = &character.skeleton.as_ref().unwrap().names;
+        let row = |key: &str| -> Vec<(String, f64)> {
+            w[key]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|r| {
+                    (
+                        r["joint"].as_str().unwrap().to_string(),
+                        r["weight"].as_f64().unwrap(),
+                    )
+                })
+                .collect()
+        };
+        let candidate = row("candidate");
+        for (joint, weight) in row("reference") {
+            let other = names.iter().find(|n| **n != joint).unwrap();
+            let swapped = candidate.iter().find(|(j, _)| j == other).unwrap();
+            assert!((swapped.1 - weight).abs() < 1e-5, "{w}");
+        }
+    }
 }

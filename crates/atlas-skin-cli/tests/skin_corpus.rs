@@ -5,7 +5,7 @@
 
 mod support;
 
-use atlas_skin_corpus::{node_check, Model, MODELS, RIGGEDFIGURE};
+use atlas_skin_corpus::{node_check, Model, MAKEHUMAN, MODELS, RIGGEDFIGURE};
 use atlas_skin_io::{load_character, LoadOptions};
 use serde_json::Value;
 use std::ffi::OsString;
@@ -107,6 +107,7 @@ fn skin_runs_on_every_corpus_model_and_writes_valid_bound_skins() {
             "joints",
             "unreachable_vertices",
             "fallback_weighted_vertices",
+            "leaf_patches",
         ] {
             assert!(
                 report["counts"][count].is_u64(),
@@ -213,4 +214,63 @@ fn options_reach_the_method_and_bad_ones_are_refused() {
         assert!(!output.status.success(), "{flag} {value} accepted");
         assert!(stderr.contains(message), "{flag} {value}: {stderr}");
     }
+}
+
+#[test]
+fn makehuman_face_bones_move_the_skin_around_their_tails() {
+    // MakeHuman's face chains end in leaf bones lying in the skin (lips, eyelids, cheeks);
+    // the .mhskel gives their tails. The tongue's leaves lie in the mouth, outside the
+    // mesh, and a forbidden joint moves nothing.
+    let dir = out_dir("skin-makehuman-face");
+    let glb = dir.join("makehuman.glb");
+    let report = dir.join("report.json");
+    let args = [
+        "-o".into(),
+        glb.clone().into_os_string(),
+        "--report".into(),
+        report.clone().into_os_string(),
+        "--forbid".into(),
+        "oris05".into(),
+    ];
+    let output = run_skin(&MAKEHUMAN, &args);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let character = load_character(&glb, &LoadOptions::default()).expect("output loads");
+    let weights = character.reference_weights.expect("weights");
+    let skeleton = character.skeleton.expect("skeleton");
+    let largest = |name: &str| {
+        let joint = skeleton.find(name).expect(name) as u32;
+        (0..weights.vertex_count())
+            .flat_map(|v| weights.row(v))
+            .filter(|&(j, _)| j == joint)
+            .map(|(_, w)| w)
+            .fold(0.0f32, f32::max)
+    };
+    for side in ["L", "R"] {
+        for leaf in [
+            "levator05",
+            "levator06",
+            "oris03",
+            "oris07",
+            "risorius03",
+            "oculi01",
+        ] {
+            let name = format!("{leaf}.{side}");
+            assert!(largest(&name) > 0.4, "{name}: {}", largest(&name));
+        }
+        for tongue in ["tongue05", "tongue06", "tongue07"] {
+            assert_eq!(largest(&format!("{tongue}.{side}")), 0.0, "{tongue}.{side}");
+        }
+    }
+    assert!(largest("oris01") > 0.4);
+    assert_eq!(largest("oris05"), 0.0);
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("JSON");
+    let patches = report["counts"]["leaf_patches"]
+        .as_u64()
+        .expect("leaf_patches");
+    assert!((15..=20).contains(&patches), "{patches} leaf patches");
 }

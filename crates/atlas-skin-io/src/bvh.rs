@@ -35,6 +35,8 @@ struct Joint {
     parent: u32,
     offset: Vec3,
     channels: Vec<Channel>,
+    /// OFFSET of the joint's End Site, if it has one: where its bone ends.
+    end_site: Option<Vec3>,
     /// Line of the joint's `{`, for unclosed-brace errors.
     open_line: usize,
 }
@@ -49,7 +51,8 @@ pub fn read(path: &Path) -> Result<Skeleton, IoError> {
 /// - Joints are the ROOT and JOINT entries (End Sites are not joints), named as in the
 ///   file. A joint's bind position is the sum of the OFFSETs from its root down to it; its
 ///   orientation is the identity (the bind pose is all rotations zero), so its inverse
-///   bind matrix is translation(−position).
+///   bind matrix is translation(−position). A joint with an End Site has its tail
+///   ([`Skeleton::tails`]) at its position plus the End Site's OFFSET.
 /// - The rig has one node per joint with rest transform translation(OFFSET).
 /// - The clip (named after the file) has, per frame k at time k · frame time, for every
 ///   joint with rotation channels `R = R_c1 · R_c2 · R_c3` (the channels in file order,
@@ -120,6 +123,7 @@ fn read_hierarchy(tokens: &mut Tokens) -> Result<Vec<Joint>, IoError> {
                     parent,
                     offset: Vec3::ZERO,
                     channels: Vec::new(),
+                    end_site: None,
                     open_line: tokens.line(),
                 });
             }
@@ -135,7 +139,12 @@ fn read_hierarchy(tokens: &mut Tokens) -> Result<Vec<Joint>, IoError> {
                 let offset = tokens.point()?;
                 match open.last() {
                     Some(Some(j)) => joints[*j as usize].offset = offset,
-                    Some(None) => {}
+                    Some(None) => {
+                        // The End Site's joint is the innermost open joint.
+                        if let Some(Some(j)) = open.iter().rev().find(|b| b.is_some()) {
+                            joints[*j as usize].end_site = Some(offset);
+                        }
+                    }
                     None => return Err(tokens.error("OFFSET outside a joint")),
                 }
             }
@@ -271,10 +280,17 @@ fn bind_skeleton(path: &Path, joints: &[Joint]) -> Result<Skeleton, IoError> {
     }
     let names = joints.iter().map(|j| j.name.clone()).collect();
     let parents = joints.iter().map(|j| j.parent).collect();
-    Skeleton::from_positions(names, parents, &positions).map_err(|cause| IoError::Skeleton {
-        path: path.to_path_buf(),
-        cause,
-    })
+    let tails = joints
+        .iter()
+        .zip(&positions)
+        .map(|(joint, &p)| joint.end_site.map(|offset| p + offset))
+        .collect();
+    Skeleton::from_positions(names, parents, &positions)
+        .and_then(|skeleton| skeleton.with_tails(tails))
+        .map_err(|cause| IoError::Skeleton {
+            path: path.to_path_buf(),
+            cause,
+        })
 }
 
 /// Converts the frames into rotation and translation tracks (see [`read_motion`]).
@@ -361,6 +377,7 @@ mod tests {
             skeleton.bind_positions(),
             [Vec3::new(1.0, 2.0, 3.0), Vec3::new(1.0, -2.0, 3.0)]
         );
+        assert_eq!(skeleton.tails, [None, Some(Vec3::new(1.0, -3.0, 3.0))]);
         assert_eq!(rig.rest[1].translation, Vec3::new(0.0, -4.0, 0.0));
         assert_eq!(clip.name, "walk");
         assert_eq!(clip.duration, 0.5);

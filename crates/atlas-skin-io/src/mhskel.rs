@@ -19,56 +19,75 @@ struct Document {
 #[derive(Deserialize)]
 struct Bone {
     head: String,
+    #[serde(default)]
+    tail: Option<String>,
     parent: Option<String>,
 }
 
 /// Reads the `.mhskel` at `path`. Each bone becomes a joint named after it (in name order)
 /// at its head: `head = (1/n) Σ file_positions[v]` over the n vertices the file lists for
-/// the head's joint entry. `file_positions` is the base mesh's full vertex list in file
+/// the head's joint entry; its tail, when the file gives one, is placed the same way
+/// ([`Skeleton::tails`]). `file_positions` is the base mesh's full vertex list in file
 /// order (base.obj, before any group selection).
 pub fn read(path: &Path, file_positions: &[Vec3]) -> Result<Skeleton, IoError> {
     let document: Document = read_json(path)?;
     let mut names = Vec::with_capacity(document.bones.len());
     let mut parents = Vec::with_capacity(document.bones.len());
     let mut inverse_bind = Vec::with_capacity(document.bones.len());
-    for (name, bone) in document.bones {
-        let vertices = document.joints.get(&bone.head).ok_or_else(|| {
-            IoError::invalid(
-                path,
-                format!(
-                    "bone {name:?}: head joint {:?} is not in \"joints\"",
-                    bone.head
-                ),
-            )
-        })?;
-        if vertices.is_empty() {
-            return Err(IoError::invalid(
-                path,
-                format!("bone {name:?}: head joint {:?} lists no vertex", bone.head),
-            ));
-        }
-        let mut sum = Vec3::ZERO;
-        for &v in vertices {
-            let position = usize::try_from(v)
-                .ok()
-                .and_then(|v| file_positions.get(v))
-                .ok_or_else(|| {
-                    IoError::invalid(
-                        path,
-                        format!(
-                        "bone {name:?}: vertex {v} is out of range (the mesh file has {} vertices)",
-                        file_positions.len()
-                    ),
-                    )
-                })?;
-            sum += *position;
-        }
-        let head = sum / vertices.len() as f32;
-        names.push(name);
-        parents.push(bone.parent.filter(|p| !p.is_empty()));
+    let mut tails = Vec::with_capacity(document.bones.len());
+    for (name, bone) in &document.bones {
+        let place = |joint: &str| joint_position(path, &document, file_positions, name, joint);
+        let head = place(&bone.head)?;
+        tails.push(bone.tail.as_deref().map(place).transpose()?);
+        names.push(name.clone());
+        parents.push(bone.parent.clone().filter(|p| !p.is_empty()));
         inverse_bind.push(Mat4::from_translation(-head));
     }
-    skeleton_from_parent_names(path, names, &parents, inverse_bind)
+    skeleton_from_parent_names(path, names, &parents, inverse_bind)?
+        .with_tails(tails)
+        .map_err(|cause| IoError::Skeleton {
+            path: path.to_path_buf(),
+            cause,
+        })
+}
+
+/// The mean of the base-mesh vertices listed for `joint`, an end of bone `bone`.
+fn joint_position(
+    path: &Path,
+    document: &Document,
+    file_positions: &[Vec3],
+    bone: &str,
+    joint: &str,
+) -> Result<Vec3, IoError> {
+    let vertices = document.joints.get(joint).ok_or_else(|| {
+        IoError::invalid(
+            path,
+            format!("bone {bone:?}: joint {joint:?} is not in \"joints\""),
+        )
+    })?;
+    if vertices.is_empty() {
+        return Err(IoError::invalid(
+            path,
+            format!("bone {bone:?}: joint {joint:?} lists no vertex"),
+        ));
+    }
+    let mut sum = Vec3::ZERO;
+    for &v in vertices {
+        let position = usize::try_from(v)
+            .ok()
+            .and_then(|v| file_positions.get(v))
+            .ok_or_else(|| {
+                IoError::invalid(
+                    path,
+                    format!(
+                        "bone {bone:?}: vertex {v} is out of range (the mesh file has {} vertices)",
+                        file_positions.len()
+                    ),
+                )
+            })?;
+        sum += *position;
+    }
+    Ok(sum / vertices.len() as f32)
 }
 
 #[cfg(test)]
@@ -98,6 +117,8 @@ mod tests {
             skeleton.bind_positions(),
             [Vec3::X, Vec3::new(0.0, 4.0, 0.0)]
         );
+        let tail = Some(Vec3::new(2.0, 0.0, 0.0));
+        assert_eq!(skeleton.tails, [tail, tail]);
     }
 
     #[test]
@@ -118,7 +139,7 @@ mod tests {
             (bone("\"z\"", "[0]"), "unknown parent \"z\""),
             (
                 r#"{"bones": {"a": {"head": "q", "parent": null}}, "joints": {}}"#.to_string(),
-                "is not in \"joints\"",
+                "joint \"q\" is not in \"joints\"",
             ),
             ("{\"bones\": 1}".to_string(), ":1: invalid type"),
         ];

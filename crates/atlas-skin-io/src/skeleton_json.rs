@@ -8,8 +8,9 @@
 //! ```
 //!
 //! `position` is the joint's bind position in the mesh's space, `rotation` its optional
-//! bind orientation as a unit quaternion `[x, y, z, w]` (identity when absent). Joints may
-//! be listed in any order; parents are named.
+//! bind orientation as a unit quaternion `[x, y, z, w]` (identity when absent), `tail` the
+//! optional end of its bone ([`Skeleton::tails`]). Joints may be listed in any order;
+//! parents are named.
 
 use crate::text::read_json;
 use crate::IoError;
@@ -33,6 +34,8 @@ struct JointEntry {
     position: [f32; 3],
     #[serde(default)]
     rotation: Option<[f32; 4]>,
+    #[serde(default)]
+    tail: Option<[f32; 3]>,
 }
 
 /// Reads the JSON skeleton at `path`. The inverse bind matrix of a joint at position p with
@@ -66,12 +69,22 @@ pub fn read(path: &Path) -> Result<Skeleton, IoError> {
         let bind = Mat4::from_rotation_translation(rotation.normalize(), position);
         inverse_bind.push(bind.inverse());
     }
+    let tails = document
+        .joints
+        .iter()
+        .map(|joint| joint.tail.map(Vec3::from_array))
+        .collect();
     let (names, parents): (Vec<String>, Vec<Option<String>>) = document
         .joints
         .into_iter()
         .map(|joint| (joint.name, joint.parent))
         .unzip();
-    skeleton_from_parent_names(path, names, &parents, inverse_bind)
+    skeleton_from_parent_names(path, names, &parents, inverse_bind)?
+        .with_tails(tails)
+        .map_err(|cause| IoError::Skeleton {
+            path: path.to_path_buf(),
+            cause,
+        })
 }
 
 /// Builds a skeleton whose parents are given by name (`None` for a root), rejecting empty
@@ -125,11 +138,12 @@ mod tests {
     fn joints_in_any_order_with_rotation() {
         let text = r#"{"joints": [
             {"name": "tip", "parent": "root", "position": [0, 2, 0], "rotation": [0, 0, 0.70710677, 0.70710677]},
-            {"name": "root", "parent": null, "position": [0, 1, 0]}
+            {"name": "root", "parent": null, "position": [0, 1, 0], "tail": [0, 1.5, 0]}
         ]}"#;
         let skeleton = read(&scratch_file("s.json", text)).unwrap();
         assert_eq!(skeleton.names, ["tip", "root"]);
         assert_eq!(skeleton.parents, [1, NO_PARENT]);
+        assert_eq!(skeleton.tails, [None, Some(Vec3::new(0.0, 1.5, 0.0))]);
         assert!(skeleton.bind_positions()[0].abs_diff_eq(Vec3::new(0.0, 2.0, 0.0), 1e-6));
         let x_axis = skeleton.bind_world()[0].x_axis.truncate();
         assert!(x_axis.abs_diff_eq(Vec3::Y, 1e-6), "{x_axis}");

@@ -18,6 +18,8 @@ pub enum RuntimeError {
     LengthMismatch { what: String },
     #[error("joint {joint} ({name:?}) has a non-finite or singular bind matrix")]
     BadBindMatrix { joint: usize, name: String },
+    #[error("joint {joint} ({name:?}) has a non-finite bone tail")]
+    BadTail { joint: usize, name: String },
     #[error("vertex {vertex} refers to joint {joint}, but the skeleton has {count} joints")]
     JointOutOfRange {
         vertex: usize,

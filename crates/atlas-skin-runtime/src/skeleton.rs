@@ -14,6 +14,10 @@ pub const NO_PARENT: u32 = u32::MAX;
 ///   joint's local frame (glTF's inverseBindMatrices). The bind pose of joint j is
 ///   `inverse_bind[j].inverse()`, its position the translation of that matrix.
 ///
+/// - `tails`: #J bind-space far ends of the joints' bones where the file gives them
+///   (MakeHuman bone tails, BVH end sites), `None` elsewhere. Skinning never reads them;
+///   automatic weighting does: a leaf joint's bone runs from its position to its tail.
+///
 /// The rest pose used for posing is the bind pose: joint j's rest local transform is
 /// `bind_world[parent]⁻¹ · bind_world[j]` (for a root, `bind_world[j]`).
 #[derive(Debug, Clone, PartialEq)]
@@ -21,6 +25,7 @@ pub struct Skeleton {
     pub names: Vec<String>,
     pub parents: Vec<u32>,
     pub inverse_bind: Vec<Mat4>,
+    pub tails: Vec<Option<Vec3>>,
 }
 
 impl Skeleton {
@@ -32,6 +37,7 @@ impl Skeleton {
         inverse_bind: Vec<Mat4>,
     ) -> Result<Self, RuntimeError> {
         let skeleton = Self {
+            tails: vec![None; names.len()],
             names,
             parents,
             inverse_bind,
@@ -54,6 +60,14 @@ impl Skeleton {
         Self::new(names, parents, inverse_bind)
     }
 
+    /// The same skeleton with bone tails (see the type's documentation); checks that there
+    /// is one entry per joint and that every tail is finite.
+    pub fn with_tails(mut self, tails: Vec<Option<Vec3>>) -> Result<Self, RuntimeError> {
+        self.tails = tails;
+        self.validate()?;
+        Ok(self)
+    }
+
     /// Number of joints.
     pub fn len(&self) -> usize {
         self.names.len()
@@ -67,14 +81,28 @@ impl Skeleton {
     /// Checks the invariants listed on [`Skeleton::new`].
     pub fn validate(&self) -> Result<(), RuntimeError> {
         let count = self.names.len();
-        if self.parents.len() != count || self.inverse_bind.len() != count {
+        if self.parents.len() != count
+            || self.inverse_bind.len() != count
+            || self.tails.len() != count
+        {
             return Err(RuntimeError::LengthMismatch {
                 what: format!(
-                    "{} names, {} parents, {} inverse bind matrices",
+                    "{} names, {} parents, {} inverse bind matrices, {} tails",
                     count,
                     self.parents.len(),
-                    self.inverse_bind.len()
+                    self.inverse_bind.len(),
+                    self.tails.len()
                 ),
+            });
+        }
+        if let Some(joint) = self
+            .tails
+            .iter()
+            .position(|t| t.is_some_and(|t| !t.is_finite()))
+        {
+            return Err(RuntimeError::BadTail {
+                joint,
+                name: self.names[joint].clone(),
             });
         }
         for (joint, &parent) in self.parents.iter().enumerate() {
@@ -219,6 +247,21 @@ mod tests {
         for (n, p, m) in cases {
             assert!(Skeleton::new(n, p.clone(), m).is_err(), "accepted {p:?}");
         }
+    }
+
+    #[test]
+    fn tails_need_one_finite_entry_per_joint() {
+        assert_eq!(chain().tails, vec![None; 3]);
+        let tails = vec![None, None, Some(Vec3::Y * 3.0)];
+        assert_eq!(chain().with_tails(tails.clone()).unwrap().tails, tails);
+        assert!(matches!(
+            chain().with_tails(vec![None; 2]),
+            Err(RuntimeError::LengthMismatch { .. })
+        ));
+        assert!(matches!(
+            chain().with_tails(vec![None, Some(Vec3::NAN), None]),
+            Err(RuntimeError::BadTail { joint: 1, .. })
+        ));
     }
 
     #[test]

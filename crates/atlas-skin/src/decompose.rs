@@ -206,7 +206,10 @@ pub fn decompose(
         &sides(false),
     );
 
-    let (boundaries, joints) = decide_joints(skeleton, outcomes, &joint_region, &searches);
+    let (boundaries, mut joints) = decide_joints(skeleton, outcomes, &joint_region, &searches);
+    for (decision, plan) in joints.iter_mut().zip(&plans) {
+        decision.owns_skin = !matches!(plan, JointPlan::Exclude(_));
+    }
     Ok(Decomposition {
         topology: split_topology,
         welded_vertex_count: mesh.vertex_count(),
@@ -239,6 +242,7 @@ fn decide_joints(
                 status: JointStatus::Skipped(reason),
                 boundary: None,
                 region,
+                owns_skin: true,
             };
             let (status, kind, frame, section, parent_region, child_region) = match outcome {
                 Outcome::Cut {
@@ -286,6 +290,7 @@ fn decide_joints(
                 status,
                 boundary: Some(boundaries.len() as u32 - 1),
                 region,
+                owns_skin: true,
             }
         })
         .collect();
@@ -316,7 +321,7 @@ fn search_all_cuts(
                     .collect();
                 find_cut_candidates(surface, frame, &other_bones)
             }
-            JointPlan::Skip(_) => CutSearch::default(),
+            JointPlan::Skip(_) | JointPlan::Exclude(_) => CutSearch::default(),
         })
         .collect()
 }
@@ -417,7 +422,9 @@ fn place_cuts(
         .zip(searches)
         .map(|((plan, placed), search)| {
             let frame = match plan {
-                JointPlan::Skip(reason) => return Placement::Skip(reason.clone()),
+                JointPlan::Skip(reason) | JointPlan::Exclude(reason) => {
+                    return Placement::Skip(reason.clone())
+                }
                 JointPlan::Soft(frame, reason) => {
                     return Placement::Soft {
                         reason: reason.clone(),

@@ -76,7 +76,7 @@ pub enum JointStatus {
     /// A soft boundary, with why no cut was placed.
     Soft(String),
     /// No boundary, with why (root, end site, branching joint on the mirror plane at the
-    /// junction of its branches or at the skin, outside the mesh and owning no geometry,
+    /// skin, outside the mesh and owning no geometry,
     /// forbidden by the user, ...).
     Skipped(String),
 }
@@ -91,4 +91,8 @@ pub struct JointDecision {
     pub boundary: Option<u32>,
     /// The region the joint's bone lies in.
     pub region: Option<u32>,
+    /// False when the joint must move no skin: forbidden by the user, or outside the mesh
+    /// owning no geometry (then it moves only what the nearest-bone fallback gives it).
+    #[serde(skip)]
+    pub owns_skin: bool,
 }

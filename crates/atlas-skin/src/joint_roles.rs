@@ -90,6 +90,9 @@ pub enum JointPlan {
     Soft(JointFrame, String),
     /// No boundary, with the reason for the report.
     Skip(String),
+    /// No boundary and no skin at all (forbidden by the user, or outside the mesh), with
+    /// the reason for the report.
+    Exclude(String),
 }
 
 /// A user override for one joint.
@@ -145,7 +148,7 @@ pub fn plan_joints(
         .map(|j| {
             let forced = overrides[j] == Some(Override::Force);
             if overrides[j] == Some(Override::Forbid) {
-                return JointPlan::Skip("forbidden by the user".into());
+                return JointPlan::Exclude("forbidden by the user".into());
             }
             let p = positions[j];
             let parent = skeleton.parent(j);
@@ -195,7 +198,7 @@ pub fn plan_joints(
             if surface_distance > params.outside_ratio * longest_bone
                 && !is_inside_by_rays(mesh, spheres, p, orientation)
             {
-                return JointPlan::Skip(format!(
+                return JointPlan::Exclude(format!(
                     "outside the mesh, owns no geometry: nearest surface {surface_distance:.4} \
                      away, longest bone {longest_bone:.4}"
                 ));
@@ -212,12 +215,15 @@ pub fn plan_joints(
                     ));
                 }
                 if child_lengths[child_lengths.len() / 2] < section_diameter {
-                    return JointPlan::Skip(format!(
-                        "branching joint on the mirror plane at the junction of its branches: \
+                    return JointPlan::Soft(
+                        frame,
+                        format!(
+                            "branching joint on the mirror plane at the junction of its branches: \
                          most of them start within its cross-section (median child bone \
-                         {:.4}, section diameter about {section_diameter:.4})",
-                        child_lengths[child_lengths.len() / 2]
-                    ));
+                         {:.4}, section diameter about {section_diameter:.4}): no cut fits",
+                            child_lengths[child_lengths.len() / 2]
+                        ),
+                    );
                 }
                 if child_lengths[0] < section_diameter {
                     return JointPlan::Soft(

@@ -17,6 +17,8 @@ pub mod joint_roles;
 pub mod mesh;
 pub mod nearest_bone;
 pub mod overlap;
+pub mod ownership;
+pub mod patches;
 pub mod pipeline;
 pub mod plane_section;
 pub mod proximity;

@@ -5,9 +5,10 @@ use atlas_skin_runtime::{Skeleton, VertexWeights};
 use glam::DVec3;
 
 /// Bone segments of every joint: joint j moves the segments from j to each of its children;
-/// a leaf j continues its parent's bone p→j by half its length (j, j + (j − p)/2), so that
-/// what lies beyond an end joint binds to it rather than to the parent; a lone root has the
-/// point (j, j). Returns (joint, start, end) triples.
+/// a leaf j has the segment to its tail when the skeleton gives one ([`Skeleton::tails`]),
+/// and otherwise continues its parent's bone p→j by half its length (j, j + (j − p)/2), so
+/// that what lies beyond an end joint binds to it rather than to the parent; a lone root
+/// without a tail has the point (j, j). Returns (joint, start, end) triples.
 pub fn bone_segments(skeleton: &Skeleton) -> Vec<(u32, DVec3, DVec3)> {
     let positions: Vec<DVec3> = skeleton
         .bind_positions()
@@ -18,9 +19,12 @@ pub fn bone_segments(skeleton: &Skeleton) -> Vec<(u32, DVec3, DVec3)> {
     let mut segments = Vec::new();
     for (j, kids) in children.iter().enumerate() {
         if kids.is_empty() {
-            let beyond = skeleton.parent(j).map_or(positions[j], |p| {
-                positions[j] + (positions[j] - positions[p]) * 0.5
-            });
+            let beyond = match skeleton.tails[j] {
+                Some(tail) => tail.as_dvec3(),
+                None => skeleton.parent(j).map_or(positions[j], |p| {
+                    positions[j] + (positions[j] - positions[p]) * 0.5
+                }),
+            };
             segments.push((j as u32, positions[j], beyond));
         }
         for &c in kids {

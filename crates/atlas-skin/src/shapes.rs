@@ -161,6 +161,7 @@ fn chain_skeleton(points: &[DVec3], names: &[&str]) -> Skeleton {
         parents: (0..count)
             .map(|k| if k == 0 { NO_PARENT } else { k as u32 - 1 })
             .collect(),
+        tails: vec![None; count],
         inverse_bind: points
             .iter()
             .map(|p| Mat4::from_translation(-p.as_vec3()))

@@ -16,29 +16,46 @@
 //! 3. **Chain weights inside a region.** A region is bound to its first joint; each other
 //!    joint of the region with a soft boundary also moves part of it. Joint c's soft boundary
 //!    (plane point o_c, normal n_c toward its child, half-width w_c) gives
-//!    s_c(p) = β(clamp((w_c + n_c·(p − o_c)) / (2 w_c), 0, 1)) · κ_c(p) on its child side
-//!    and 0 elsewhere. κ_c keeps the joint on its own part: with a(p) the distance from p
-//!    to the nearest of the joint's own bones (its child bones and every bone below them)
-//!    and b(p) to the nearest other bone of the region (bones of joints whose bone lies in
-//!    it, except the joint's own upper bone, which meets its child bones at the joint),
-//!    κ_c(p) = β(clamp(1 − (a − b) / w_c, 0, 1)), and 1 when the region has no other
-//!    bone. It is 1 wherever the own bones are the nearer and falls to 0 within one
-//!    half-width past the surface equidistant from both, as a cut's weight falls within
-//!    its overlap band: a plane whose child side holds a sibling's part (a jaw's, the front
-//!    of the neck) leaves that part to the bones that run inside it. The region's joints
-//!    form a tree (each soft joint under its nearest ancestor among them, the bound joint
-//!    at the root); a node of mass m keeps m (1 − min(1, S)) and passes m s_c / max(1, S)
-//!    to each child c, S = Σ_c s_c. Masses are non-negative, sum to m, and are continuous.
+//!    s_c(p) = max(β(clamp((w_c + n_c·(p − o_c)) / (2 w_c), 0, 1)), π_c(p)) · κ_c(p) on its
+//!    child side and 0 elsewhere. κ_c ([`crate::ownership`]) keeps the joint on its own
+//!    part: with a(p) the distance from p to the nearest of the joint's own bones (its child
+//!    bones and every bone below them) and b(p) to the nearest other bone of the region
+//!    (bones of joints whose bone lies in it, except the joint's own upper bone, which meets
+//!    its child bones at the joint), κ_c(p) = β(clamp(1 − (a − b) / w_c, 0, 1)), and 1 when
+//!    the region has no other bone. It is 1 wherever the own bones are the nearer and falls
+//!    to 0 within one half-width past the surface equidistant from both, as a cut's weight
+//!    falls within its overlap band: a plane whose child side holds a sibling's part (a
+//!    jaw's, the front of the neck) leaves that part to the bones that run inside it.
+//!    π_c, the same formula with the bones of c's descendants that have no boundary of
+//!    their own as own bones and c's child bones plus the region's other bones as others,
+//!    carries c's part past its plane where such a bone is the nearest: a chin that hangs
+//!    below the plane of the head joint but lies on the jaw bone moves with the head.
+//!    The region's joints form a tree (each soft joint under its nearest ancestor among
+//!    them that does not branch, the bound joint at the root: a branching joint's plane
+//!    says nothing about where its branches go, so a shoulder hangs under the spine, not
+//!    under the chest beside it). Visiting the nodes parents first, the children c of a
+//!    node take, with S = Σ_c s_c, the share min(1, S) of the mass of every node on the
+//!    chain from the root to that node; child c receives the pooled amount times
+//!    s_c / max(1, S). (Taking from the whole chain rather than the node alone lets the
+//!    head take the chin from the neck where the upper neck's plane does not reach it.)
+//!    Masses are non-negative, sum to the region's weight ω, and are continuous.
 //!
 //!    The child side is not a half-space: it is the set of vertices reached *along the
 //!    surface* from the joint's own cross-section (vertices within the plane's band and
-//!    near the joint) without crossing the far edge of the band (n_c·(p − o_c) ≤ −w_c),
-//!    leaving the region and its overlaps, or reaching κ_c = 0. A plane through a shoulder
-//!    therefore never reaches a thigh that the hand touches, and a soft boundary acts only
-//!    inside its own region: the surface-distance guarantee of §3.3 holds for soft
-//!    boundaries too (κ_c, a Euclidean nearest-bone test, only ever removes vertices from
-//!    the flood, never adds any). A soft boundary with no cross-section near its joint is
-//!    inactive (see `soft_sides`).
+//!    near the joint) without crossing the far edge of the band (n_c·(p − o_c) ≤ −w_c)
+//!    where π_c = 0, leaving the region and its overlaps, or reaching κ_c = 0. A plane
+//!    through a shoulder therefore never reaches a thigh that the hand touches, and a soft
+//!    boundary acts only inside its own region: the surface-distance guarantee of §3.3
+//!    holds for soft boundaries too (κ_c and π_c, Euclidean nearest-bone tests, only ever
+//!    remove vertices from the flood or extend it within the region, never across a
+//!    region's edge). A soft boundary with no cross-section near its joint is inactive
+//!    (see `soft_sides`).
+//!
+//!    **3b. Leaf patches.** A leaf bone with a stated tail and no active boundary (a face
+//!    bone lying in the skin) takes a share p_j of the region's weight at every vertex of
+//!    its patch ([`crate::patches`]): with P = Σ_j p_j over the region's patches, every
+//!    joint of the region keeps its mass times 1 − min(1, P), and patch j receives
+//!    ω p_j / max(1, P).
 //! 4. **Fallback.** A vertex that no region with joints reaches (a loose piece, a
 //!    degenerate bit, a region without joints) copies the weights of the nearest weighted
 //!    vertex along the surface's edges (Dijkstra) when its component has one, and is bound
@@ -48,7 +65,9 @@ use crate::blend::{beta, blend_regions, Blend};
 use crate::geodesic::BandDistances;
 use crate::nearest_bone::{bone_segments, point_segment_distance};
 use crate::overlap::{OverlapParams, Overlaps};
-use crate::{Boundary, BoundaryKind, Decomposition, JointDecision};
+use crate::ownership::Ownership;
+use crate::patches::{leaf_patches, Patch};
+use crate::{BoundaryKind, Decomposition};
 use atlas_skin_runtime::{Skeleton, VertexWeights};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -149,6 +168,8 @@ pub struct WeightCounts {
     pub from_bone: usize,
     /// Joints whose soft boundary is inactive (no cross-section near the joint).
     pub inactive_soft_joints: Vec<u32>,
+    /// Leaf joints that move a patch of skin (step 3b).
+    pub leaf_patches: Vec<u32>,
 }
 
 /// Weights of every vertex of `decomposition.surface` (module documentation).
@@ -165,10 +186,30 @@ pub fn compute_weights(
     let vertex_count = decomposition.surface.vertex_count();
     let bands = vertex_bands(&overlaps.bands, vertex_count);
     let related = related_regions(decomposition, overlaps, &bands);
-    let softs = soft_sides(decomposition, skeleton, overlaps, &related);
+    let region_vertices = region_vertices(decomposition, &related);
+    let softs = soft_sides(
+        decomposition,
+        skeleton,
+        overlaps,
+        &related,
+        &region_vertices,
+    );
+    let active: Vec<bool> = decomposition
+        .joints
+        .iter()
+        .enumerate()
+        .map(|(j, decision)| {
+            decision.boundary.is_some_and(|k| {
+                decomposition.boundaries[k as usize].kind != BoundaryKind::Soft
+                    || softs.iter().any(|s| s.joint as usize == j)
+            })
+        })
+        .collect();
+    let patches = leaf_patches(decomposition, skeleton, &active, &region_vertices);
     let trees = region_trees(decomposition, skeleton, &softs);
-    let mut weights = blend_vertices(decomposition, &related, &softs, &trees, blend);
+    let mut weights = blend_vertices(decomposition, &related, &softs, &patches, &trees, blend);
     let mut counts = fill_unweighted(decomposition, skeleton, &mut weights);
+    counts.leaf_patches = patches.iter().map(|p| p.joint).collect();
     counts.inactive_soft_joints = decomposition
         .boundaries
         .iter()
@@ -313,9 +354,28 @@ fn par_rows<S: Default, T: Send>(
 
 /// Per vertex, the (boundary, surface distance) of every cut band that reaches it.
 fn vertex_bands(bands: &[BandDistances], vertex_count: usize) -> Rows<(u32, f64)> {
+    by_vertex(vertex_count, || {
+        bands
+            .iter()
+            .map(|band| {
+                band.vertices
+                    .iter()
+                    .copied()
+                    .zip(band.distances.iter().copied())
+            })
+            .collect()
+    })
+}
+
+/// Rows over `0..vertex_count`: row v lists (k, value) for every entry (v, value) of list
+/// k, in list order. `lists` is called twice (to count, then to fill).
+fn by_vertex<I: Iterator<Item = (u32, f64)>>(
+    vertex_count: usize,
+    lists: impl Fn() -> Vec<I>,
+) -> Rows<(u32, f64)> {
     let mut offsets = vec![0u32; vertex_count + 1];
-    for band in bands {
-        for &v in &band.vertices {
+    for list in lists() {
+        for (v, _) in list {
             offsets[v as usize + 1] += 1;
         }
     }
@@ -324,9 +384,9 @@ fn vertex_bands(bands: &[BandDistances], vertex_count: usize) -> Rows<(u32, f64)
     }
     let mut fill = offsets.clone();
     let mut values = vec![(0u32, 0.0); offsets[vertex_count] as usize];
-    for (k, band) in bands.iter().enumerate() {
-        for (&v, &d) in band.vertices.iter().zip(&band.distances) {
-            values[fill[v as usize] as usize] = (k as u32, d);
+    for (k, list) in lists().into_iter().enumerate() {
+        for (v, value) in list {
+            values[fill[v as usize] as usize] = (k as u32, value);
             fill[v as usize] += 1;
         }
     }
@@ -387,8 +447,8 @@ struct SoftSide {
     half_width: f64,
     /// Bit v set when vertex v is on the child side reached along the surface.
     reached: Vec<u64>,
-    /// κ_c of every reached vertex, by increasing vertex.
-    ownership: Vec<(u32, f64)>,
+    /// (κ_c, beyond_c) of every reached vertex, by increasing vertex.
+    ownership: Vec<(u32, f64, f64)>,
 }
 
 impl SoftSide {
@@ -397,84 +457,25 @@ impl SoftSide {
         if self.reached[v / 64] & (1 << (v % 64)) == 0 {
             return 0.0;
         }
-        let kappa = self
+        let (kappa, beyond) = self
             .ownership
-            .binary_search_by_key(&(v as u32), |&(u, _)| u)
-            .map_or(0.0, |i| self.ownership[i].1);
+            .binary_search_by_key(&(v as u32), |&(u, _, _)| u)
+            .map_or((0.0, 0.0), |i| (self.ownership[i].1, self.ownership[i].2));
         let signed = self.normal.dot(position - self.point);
         let w = self.half_width.max(f64::MIN_POSITIVE);
-        beta(((w + signed) / (2.0 * w)).clamp(0.0, 1.0)) * kappa
+        beta(((w + signed) / (2.0 * w)).clamp(0.0, 1.0)).max(beyond) * kappa
     }
 }
 
-/// The bones that decide κ_c for one soft boundary (module documentation).
-struct Ownership {
-    /// The joint's own bones: its child bones and every bone below them.
-    own_bones: Vec<(DVec3, DVec3)>,
-    /// The other bones of the region (neither the joint's own nor its upper bone).
-    other_bones: Vec<(DVec3, DVec3)>,
-    half_width: f64,
-}
-
-impl Ownership {
-    /// The bones κ compares for the soft boundary `boundary` (module documentation), as
-    /// (start, end) segments of `segments` ([`bone_segments`]): its own bones, those of
-    /// its joint and the joints below it, and the other bones of its region, those of
-    /// every other joint whose decision lies in the region except the parent's bones
-    /// ending at the joint's position (its upper bone).
-    fn new(
-        skeleton: &Skeleton,
-        decisions: &[JointDecision],
-        segments: &[(u32, DVec3, DVec3)],
-        boundary: &Boundary,
-        half_width: f64,
-    ) -> Self {
-        let joint = boundary.joint as usize;
-        let below_joint = |mut j: usize| loop {
-            if j == joint {
-                break true;
-            }
-            match skeleton.parent(j) {
-                Some(p) => j = p,
-                None => break false,
-            }
-        };
-        let joint_position = skeleton.bind_positions()[joint].as_dvec3();
-        let upper_parent = skeleton.parent(joint);
-        let mut ownership = Self {
-            own_bones: Vec::new(),
-            other_bones: Vec::new(),
-            half_width,
-        };
-        for &(j, start, end) in segments {
-            let j = j as usize;
-            if below_joint(j) {
-                ownership.own_bones.push((start, end));
-            } else if decisions[j].region == Some(boundary.parent_region)
-                && !(upper_parent == Some(j) && end == joint_position)
-            {
-                ownership.other_bones.push((start, end));
-            }
+/// Transpose of `related`: the vertices each region reaches, increasing.
+fn region_vertices(decomposition: &Decomposition, related: &Rows<(u32, f64)>) -> Vec<Vec<u32>> {
+    let mut region_vertices: Vec<Vec<u32>> = vec![Vec::new(); decomposition.regions.len()];
+    for v in 0..decomposition.surface.vertex_count() {
+        for &(r, _) in related.row(v) {
+            region_vertices[r as usize].push(v as u32);
         }
-        ownership
     }
-
-    /// κ_c(p) = β(clamp(1 − (a − b) / w_c, 0, 1)), a and b the distances from p to the
-    /// nearest own and other bone (1 without other bones).
-    fn at(&self, position: DVec3) -> f64 {
-        let nearest = |bones: &[(DVec3, DVec3)]| {
-            bones
-                .iter()
-                .map(|&(a, b)| point_segment_distance(position, a, b))
-                .fold(f64::INFINITY, f64::min)
-        };
-        let other = nearest(&self.other_bones);
-        if other == f64::INFINITY {
-            return 1.0;
-        }
-        let w = self.half_width.max(f64::MIN_POSITIVE);
-        beta((1.0 - (nearest(&self.own_bones) - other) / w).clamp(0.0, 1.0))
-    }
+    region_vertices
 }
 
 /// Step 3's child sides: for each soft boundary, a flood along edges from the vertices of
@@ -489,29 +490,35 @@ fn soft_sides(
     skeleton: &Skeleton,
     overlaps: &Overlaps,
     related: &Rows<(u32, f64)>,
+    region_vertices: &[Vec<u32>],
 ) -> Vec<SoftSide> {
     let d = decomposition;
     let positions = &d.surface.positions;
     let vertex_count = d.surface.vertex_count();
-    // Transpose of `related`: the vertices each region reaches.
-    let mut region_vertices: Vec<Vec<u32>> = vec![Vec::new(); d.regions.len()];
-    for v in 0..vertex_count {
-        for &(r, _) in related.row(v) {
-            region_vertices[r as usize].push(v as u32);
+    let segments = bone_segments(skeleton);
+    let mut handled = vec![false; skeleton.len()];
+    for b in &d.boundaries {
+        if b.kind != BoundaryKind::Soft || b.diameter > 0.0 {
+            handled[b.joint as usize] = true;
         }
     }
-    let segments = bone_segments(skeleton);
     d.boundaries
         .par_iter()
         .enumerate()
         .filter(|(_, b)| b.kind == BoundaryKind::Soft && b.diameter > 0.0)
         .filter_map(|(k, b)| {
             let half_width = overlaps.half_widths[k];
-            let owner = Ownership::new(skeleton, &d.joints, &segments, b, half_width);
+            let owner = Ownership::new(
+                skeleton,
+                &d.joints,
+                &segments,
+                b.joint as usize,
+                b.parent_region,
+                half_width,
+            );
+            let beyond = owner.beyond(skeleton, &segments, b.joint as usize, &handled);
             let signed = |v: usize| b.normal.dot(positions[v] - b.point);
-            let in_band_and_region = |v: usize| {
-                signed(v) > -half_width && related.row(v).iter().any(|&(r, _)| r == b.parent_region)
-            };
+            let in_region = |v: usize| related.row(v).iter().any(|&(r, _)| r == b.parent_region);
             // Every vertex is examined once: κ depends on the vertex alone.
             let words = vertex_count.div_ceil(64);
             let (mut examined, mut reached) = (vec![0u64; words], vec![0u64; words]);
@@ -523,13 +530,20 @@ fn soft_sides(
                     return;
                 }
                 examined[word] |= bit;
-                if !in_band_and_region(v as usize) {
+                if !in_region(v as usize) {
                     return;
                 }
-                let kappa = owner.at(positions[v as usize]);
+                let p = positions[v as usize];
+                let side = signed(v as usize);
+                // π_c matters only where the plane's own term is below 1.
+                let past = if side < half_width { beyond.at(p) } else { 0.0 };
+                if side <= -half_width && past <= 0.0 {
+                    return;
+                }
+                let kappa = owner.at(p);
                 if kappa > 0.0 {
                     reached[word] |= bit;
-                    ownership.push((v, kappa));
+                    ownership.push((v, kappa, past));
                     queue.push_back(v);
                 }
             };
@@ -548,7 +562,7 @@ fn soft_sides(
                     visit(u, &mut queue);
                 }
             }
-            ownership.sort_unstable_by_key(|&(v, _)| v);
+            ownership.sort_unstable_by_key(|&(v, _, _)| v);
             Some(SoftSide {
                 joint: b.joint,
                 region: b.parent_region,
@@ -570,6 +584,8 @@ struct RegionTree {
     /// Index into the `softs` vector of every node after the root.
     softs: Vec<usize>,
     children: Vec<Vec<usize>>,
+    /// Parent node of every node (0 for the root).
+    parents: Vec<usize>,
     order: Vec<usize>,
 }
 
@@ -578,6 +594,7 @@ fn region_trees(
     skeleton: &Skeleton,
     softs: &[SoftSide],
 ) -> Vec<RegionTree> {
+    let children = skeleton.children();
     decomposition
         .regions
         .iter()
@@ -597,18 +614,20 @@ fn region_trees(
                 }
             }
             tree.children = vec![Vec::new(); tree.joints.len()];
+            tree.parents = vec![0; tree.joints.len()];
             for node in 1..tree.joints.len() {
                 let mut ancestor = skeleton.parent(tree.joints[node] as usize);
                 let parent = loop {
                     match ancestor {
                         None => break 0,
                         Some(a) => match tree.joints.iter().position(|&j| j as usize == a) {
-                            Some(p) => break p,
-                            None => ancestor = skeleton.parent(a),
+                            Some(p) if p == 0 || children[a].len() < 2 => break p,
+                            _ => ancestor = skeleton.parent(a),
                         },
                     }
                 };
                 tree.children[parent].push(node);
+                tree.parents[node] = parent;
             }
             tree.order = vec![0];
             let mut i = 0;
@@ -620,6 +639,16 @@ fn region_trees(
             tree
         })
         .collect()
+}
+
+/// Per vertex, the (patch, p_j) of every leaf patch holding it.
+fn patch_shares(patches: &[Patch], vertex_count: usize) -> Rows<(u32, f64)> {
+    by_vertex(vertex_count, || {
+        patches
+            .iter()
+            .map(|patch| patch.shares.iter().copied())
+            .collect()
+    })
 }
 
 /// Per-chunk working memory of [`blend_vertices`].
@@ -635,9 +664,11 @@ fn blend_vertices(
     decomposition: &Decomposition,
     related: &Rows<(u32, f64)>,
     softs: &[SoftSide],
+    patches: &[Patch],
     trees: &[RegionTree],
     blend: Blend,
 ) -> SurfaceWeights {
+    let patch_shares = patch_shares(patches, decomposition.surface.vertex_count());
     let positions = &decomposition.surface.positions;
     let rows = par_rows(positions.len(), |v, scratch: &mut BlendScratch, out| {
         let regions = related.row(v);
@@ -654,18 +685,42 @@ fn blend_vertices(
             mass.resize(tree.joints.len(), 0.0);
             mass[0] = omega;
             for &node in &tree.order {
-                let m = mass[node];
-                if m <= 0.0 {
-                    continue;
-                }
                 let share = |c: usize| softs[tree.softs[c - 1]].share(v, positions[v]);
                 let total: f64 = tree.children[node].iter().map(|&c| share(c)).sum();
-                for &c in &tree.children[node] {
-                    mass[c] = m * share(c) / total.max(1.0);
+                if total <= 0.0 {
+                    continue;
                 }
-                mass[node] = m * (1.0 - total.min(1.0));
+                // The children take their shares of the mass of the whole chain from the
+                // root to `node`.
+                let mut pool = 0.0;
+                let mut a = node;
+                loop {
+                    pool += mass[a];
+                    mass[a] *= 1.0 - total.min(1.0);
+                    if a == 0 {
+                        break;
+                    }
+                    a = tree.parents[a];
+                }
+                for &c in &tree.children[node] {
+                    mass[c] = pool * share(c) / total.max(1.0);
+                }
             }
-            for (&joint, &m) in tree.joints.iter().zip(mass.iter()) {
+            // Step 3b: the leaf patches take their shares of every joint's mass alike.
+            let in_region = patch_shares
+                .row(v)
+                .iter()
+                .filter(move |&&(k, _)| patches[k as usize].region == r);
+            let patch_total: f64 = in_region.clone().map(|&(_, p)| p).sum();
+            let keep = 1.0 - patch_total.min(1.0);
+            let patch_masses = in_region
+                .map(|&(k, p)| (patches[k as usize].joint, omega * p / patch_total.max(1.0)));
+            let joint_masses = tree
+                .joints
+                .iter()
+                .zip(mass.iter())
+                .map(|(&j, &m)| (j, m * keep));
+            for (joint, m) in joint_masses.chain(patch_masses) {
                 if m <= 0.0 {
                     continue;
                 }

@@ -4,7 +4,7 @@
 //! crossing or touching, its elbows, knees, wrists and ankles cut (by name where the file
 //! names them, by the manifest's structure otherwise), and no joint inside the mesh without
 //! a boundary unless it owns no geometry (root, end site, branching joint on the mirror
-//! plane at the junction of its branches or at the skin); the joints the paper's rules
+//! plane at the skin); the joints the paper's rules
 //! miss (toes past the ball of a foot, branching joints on the mirror plane that own a part
 //! of the trunk) have one. The open strip simpleskin finishes with a reason for every
 //! joint.

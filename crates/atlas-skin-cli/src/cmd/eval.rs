@@ -33,6 +33,10 @@ pub struct Args {
     /// (BASELINES.md does so with 4 for MakeHuman).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
     pub prune_reference: Option<u16>,
+    /// List the N vertices with the largest random-pose (LBS) error, with both weight rows
+    /// (JSON key `worst_vertices`).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub worst: usize,
     /// Print the figures as JSON.
     #[arg(long)]
     pub json: bool,
@@ -51,6 +55,7 @@ pub fn run(args: Args) -> Result<()> {
         seed: args.seed,
         anim_frames: args.anim_frames,
         reference_max_influences: args.prune_reference.map(usize::from),
+        worst: args.worst,
         ..EvalOptions::default()
     };
     let evaluation = compare(&reference, &candidate, &options)?;
@@ -154,5 +159,26 @@ fn summary(e: &Evaluation) -> String {
             v.mean_influences
         ),
     ]
-    .concat()
+    .into_iter()
+    .chain(e.worst_vertices.iter().map(worst_line))
+    .collect()
+}
+
+/// One line of the worst-vertex list.
+fn worst_line(w: &atlas_skin::eval::WorstVertex) -> String {
+    let row = |r: &[atlas_skin::eval::JointWeight]| {
+        r.iter()
+            .map(|jw| format!("{} {:.2}", jw.joint, jw.weight))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let [x, y, z] = w.position;
+    format!(
+        "worst vertex {} at ({x:.3}, {y:.3}, {z:.3}): {:.4} in pose {}; reference [{}], candidate [{}]\n",
+        w.vertex,
+        w.error,
+        w.pose,
+        row(&w.reference),
+        row(&w.candidate)
+    )
 }

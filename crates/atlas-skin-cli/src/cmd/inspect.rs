@@ -65,6 +65,8 @@ pub struct JointReport {
     pub parent_index: Option<usize>,
     pub position: [f32; 3],
     pub inside: bool,
+    /// Where the joint's bone ends, when the file says (MakeHuman tails, BVH End Sites).
+    pub tail: Option<[f32; 3]>,
 }
 
 #[derive(Debug, Serialize)]
@@ -91,6 +93,7 @@ impl Report {
                         parent_index: skeleton.parent(j),
                         position: position.to_array(),
                         inside: is_inside(&prepared.welded.mesh, position.as_dvec3()),
+                        tail: skeleton.tails[j].map(|t| t.to_array()),
                     })
                     .collect()
             }

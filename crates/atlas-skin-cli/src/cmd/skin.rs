@@ -303,6 +303,7 @@ fn report(
             "fallback_weighted_vertices": weight_counts.from_surface + weight_counts.from_bone
                 + counts.unreferenced_stored_vertices,
             "max_influences": skinned.weights.max_influences(),
+            "leaf_patches": weight_counts.leaf_patches.len(),
         },
         "warnings": warnings,
     })

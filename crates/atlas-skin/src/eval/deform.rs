@@ -79,10 +79,27 @@ pub fn animation_palettes(
         .collect()
 }
 
+/// The largest error of one vertex over all palettes, and the palette where it occurs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VertexError {
+    pub max: f64,
+    pub palette: usize,
+}
+
+/// What [`deformation_error`] measures: the mean and largest error over all vertices and
+/// palettes, and each vertex's largest error.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PerVertexErrors {
+    pub total: DeformError,
+    /// #V entries, in the order of `rest`.
+    pub vertices: Vec<VertexError>,
+}
+
 /// Deformation error of `candidate` against `reference` over `palettes`:
 /// `e_vp = ‖S(reference, P_p)(v) − S(candidate, P_p)(v)‖ / diagonal` for every vertex v and
 /// palette p, where S skins the rest mesh with the given weights; returns the mean and
-/// the largest `e_vp` (zeros when there is no vertex or no palette).
+/// the largest `e_vp` (zeros when there is no vertex or no palette), and per vertex its
+/// largest `e_vp` with the palette where it occurs.
 ///
 /// - `rest`: #V bind-space positions; `reference`, `candidate`: #V rows with joint indices
 ///   into every palette; `palettes`: #P palettes of #J matrices; `diagonal` > 0.
@@ -93,31 +110,44 @@ pub fn deformation_error(
     palettes: &[Vec<Mat4>],
     skinning: Skinning,
     diagonal: f64,
-) -> DeformError {
+) -> PerVertexErrors {
     let skin = match skinning {
         Skinning::Linear => linear_blend_positions,
         Skinning::DualQuaternion => dual_quaternion_positions,
     };
     let mut posed_ref = vec![Vec3::ZERO; rest.len()];
     let mut posed_cand = vec![Vec3::ZERO; rest.len()];
+    let mut vertices = vec![
+        VertexError {
+            max: 0.0,
+            palette: 0
+        };
+        rest.len()
+    ];
     let (mut sum, mut max) = (0.0f64, 0.0f64);
-    for palette in palettes {
+    for (p, palette) in palettes.iter().enumerate() {
         skin(rest, reference, palette, &mut posed_ref);
         skin(rest, candidate, palette, &mut posed_cand);
-        for (a, b) in posed_ref.iter().zip(&posed_cand) {
+        for ((a, b), vertex) in posed_ref.iter().zip(&posed_cand).zip(&mut vertices) {
             let e = a.as_dvec3().distance(b.as_dvec3()) / diagonal;
             sum += e;
             max = max.max(e);
+            if e > vertex.max {
+                *vertex = VertexError { max: e, palette: p };
+            }
         }
     }
     let samples = rest.len() * palettes.len();
-    DeformError {
-        mean: if samples > 0 {
-            sum / samples as f64
-        } else {
-            0.0
+    PerVertexErrors {
+        total: DeformError {
+            mean: if samples > 0 {
+                sum / samples as f64
+            } else {
+                0.0
+            },
+            max,
         },
-        max,
+        vertices,
     }
 }
 
@@ -161,7 +191,7 @@ mod tests {
         palette_from_world(&world, &skeleton.inverse_bind, &mut palette);
         let palettes = [palette];
         for skinning in [Skinning::Linear, Skinning::DualQuaternion] {
-            let same = deformation_error(&rest, &on_tip, &on_tip, &palettes, skinning, 2.0);
+            let same = deformation_error(&rest, &on_tip, &on_tip, &palettes, skinning, 2.0).total;
             assert_eq!(
                 same,
                 DeformError {
@@ -169,7 +199,8 @@ mod tests {
                     max: 0.0
                 }
             );
-            let swapped = deformation_error(&rest, &on_tip, &on_root, &palettes, skinning, 2.0);
+            let swapped =
+                deformation_error(&rest, &on_tip, &on_root, &palettes, skinning, 2.0).total;
             assert_relative_eq!(swapped.max, 2f64.sqrt() / 2.0, epsilon = 1e-6);
             assert_relative_eq!(swapped.mean, swapped.max, epsilon = 1e-12);
         }
@@ -215,7 +246,7 @@ mod tests {
         let rest = [Vec3::new(2.0, 0.0, 0.0)];
         let on_tip = VertexWeights::from_rows([vec![(1, 1.0)]]);
         let on_root = VertexWeights::from_rows([vec![(0, 1.0)]]);
-        let e = deformation_error(&rest, &on_tip, &on_root, &palettes, Skinning::Linear, 1.0);
+        let e = deformation_error(&rest, &on_tip, &on_root, &palettes, Skinning::Linear, 1.0).total;
         let expected = [7.5f64, 22.5, 37.5].map(|half| 2.0 * half.to_radians().sin());
         assert_relative_eq!(e.max, expected[2], epsilon = 1e-5);
         assert_relative_eq!(e.mean, expected.iter().sum::<f64>() / 3.0, epsilon = 1e-5);

@@ -12,11 +12,13 @@ pub mod deform;
 pub mod matching;
 pub mod validity;
 pub mod weights_l1;
+pub mod worst;
 
 pub use bleeding::Bleeding;
 pub use deform::{DeformError, Skinning};
 pub use validity::Validity;
 pub use weights_l1::WeightsL1;
+pub use worst::{JointWeight, WorstVertex};
 
 use crate::weld::UNREFERENCED;
 use crate::{Topology, Welded};
@@ -109,6 +111,9 @@ pub struct EvalOptions {
     /// Keep only this many largest reference weights per vertex before renormalising
     /// (BASELINES.md prunes MakeHuman's to 4); `None` keeps them all.
     pub reference_max_influences: Option<usize>,
+    /// How many of the vertices with the largest LBS random-pose error to list
+    /// ([`Evaluation::worst_vertices`]); 0 lists none.
+    pub worst: usize,
 }
 
 impl Default for EvalOptions {
@@ -121,6 +126,7 @@ impl Default for EvalOptions {
             bleeding_radius: 0.05,
             match_tolerance: 1e-5,
             reference_max_influences: None,
+            worst: 0,
         }
     }
 }
@@ -147,6 +153,10 @@ pub struct Evaluation {
     pub bleeding: Bleeding,
     /// Of the candidate's weights as stored (all its rows).
     pub validity: Validity,
+    /// The `options.worst` vertices with the largest LBS random-pose error, worst first
+    /// (absent from the JSON when none was asked for).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub worst_vertices: Vec<WorstVertex>,
 }
 
 /// Compares `input.candidate`'s weights with `input.reference`'s (see the module docs and
@@ -200,6 +210,7 @@ pub fn evaluate(input: &EvalInput, options: &EvalOptions) -> Result<Evaluation, 
             diagonal,
         )
     };
+    let random_lbs = deform_with(&random_palettes, Skinning::Linear);
     let sources = bleeding::joint_sources(
         &aligned.reference_stored,
         &input.surface.welded_of_stored,
@@ -212,8 +223,8 @@ pub fn evaluate(input: &EvalInput, options: &EvalOptions) -> Result<Evaluation, 
         candidate_vertices: candidate.positions.len(),
         candidate_joints: candidate.skeleton.len(),
         weights_l1: weights_l1::weights_l1(&aligned.reference, &aligned.candidate, joints),
-        deform_random: deform_with(&random_palettes, Skinning::Linear),
-        deform_random_dqs: deform_with(&random_palettes, Skinning::DualQuaternion),
+        deform_random: random_lbs.total,
+        deform_random_dqs: deform_with(&random_palettes, Skinning::DualQuaternion).total,
         deform_anim: input.animation.map(|animation| {
             let palettes = deform::animation_palettes(
                 reference.skeleton,
@@ -221,7 +232,7 @@ pub fn evaluate(input: &EvalInput, options: &EvalOptions) -> Result<Evaluation, 
                 animation.clip,
                 options.anim_frames,
             );
-            deform_with(&palettes, Skinning::Linear)
+            deform_with(&palettes, Skinning::Linear).total
         }),
         bleeding: bleeding::bleeding(
             &input.surface.mesh,
@@ -232,6 +243,17 @@ pub fn evaluate(input: &EvalInput, options: &EvalOptions) -> Result<Evaluation, 
             options.bleeding_radius * diagonal,
         ),
         validity: validity::validity(candidate.weights),
+        worst_vertices: worst::worst_vertices(
+            &random_lbs.vertices,
+            &worst::Rows {
+                stored: &aligned.stored_of_row,
+                positions: &aligned.rest_positions,
+                reference: &aligned.reference,
+                candidate: &aligned.candidate,
+                names: &reference.skeleton.names,
+            },
+            options.worst,
+        ),
     })
 }
 
@@ -240,6 +262,8 @@ pub fn evaluate(input: &EvalInput, options: &EvalOptions) -> Result<Evaluation, 
 struct Aligned {
     /// Reference stored vertices some triangle references.
     compared: usize,
+    /// #M stored index of each matched reference vertex.
+    stored_of_row: Vec<usize>,
     /// #M positions of the matched reference vertices.
     rest_positions: Vec<Vec3>,
     /// #M reference rows, pruned and renormalised.
@@ -280,6 +304,7 @@ fn align(input: &EvalInput, options: &EvalOptions, diagonal: f64) -> Result<Alig
     });
     Ok(Aligned {
         compared: compared.len(),
+        stored_of_row: pairs.iter().map(|&(r, _)| r).collect(),
         rest_positions: pairs.iter().map(|&(r, _)| reference.positions[r]).collect(),
         reference: VertexWeights::from_rows(pairs.iter().map(|&(r, _)| reference_stored.row(r))),
         candidate: VertexWeights::from_rows(pairs.iter().map(|&(_, c)| {

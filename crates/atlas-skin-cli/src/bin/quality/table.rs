@@ -231,6 +231,7 @@ mod tests {
                 max_influences: 2,
                 mean_influences: 1.5,
             },
+            worst_vertices: Vec::new(),
         }
     }
 
