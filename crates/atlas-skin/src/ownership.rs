@@ -29,6 +29,9 @@ struct Segment {
     along: DVec3,
     /// 1 / |b − a|², 0 for a point.
     inverse_length_squared: f64,
+    /// Midpoint and half length: no point of the segment is farther from the midpoint.
+    middle: DVec3,
+    half_length: f64,
 }
 
 impl Segment {
@@ -43,6 +46,8 @@ impl Segment {
             } else {
                 0.0
             },
+            middle: start + 0.5 * along,
+            half_length: 0.5 * length_squared.sqrt(),
         }
     }
 
@@ -146,12 +151,18 @@ impl Ownership {
     /// κ(p) = β(clamp(1 − (a − b) / w, 0, 1)), a and b the distances from p to the
     /// nearest own and other bone (1 without other bones, 0 without own bones).
     pub(crate) fn at(&self, position: DVec3) -> f64 {
+        // The nearest bone's distance; a bone whose bounding sphere lies farther than the
+        // best distance so far cannot be nearer and is skipped.
         let nearest = |bones: &[Segment]| {
-            bones
-                .iter()
-                .map(|bone| bone.distance_squared(position))
-                .fold(f64::INFINITY, f64::min)
-                .sqrt()
+            let mut best = f64::INFINITY;
+            for bone in bones {
+                let reach = best + bone.half_length;
+                if position.distance_squared(bone.middle) >= reach * reach {
+                    continue;
+                }
+                best = best.min(bone.distance_squared(position).sqrt());
+            }
+            best
         };
         let own = nearest(&self.own_bones);
         if own == f64::INFINITY {
@@ -163,5 +174,69 @@ impl Ownership {
         }
         let w = self.half_width.max(f64::MIN_POSITIVE);
         beta((1.0 - (own - other) / w).clamp(0.0, 1.0))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::nearest_bone::point_segment_distance;
+    use atlas_skin_runtime::random_pose::SplitMix64;
+
+    /// κ by the formula with plain point–segment distances, no pruning.
+    fn reference_kappa(own: &[[DVec3; 2]], other: &[[DVec3; 2]], w: f64, p: DVec3) -> f64 {
+        let nearest = |bones: &[[DVec3; 2]]| {
+            bones
+                .iter()
+                .map(|&[a, b]| point_segment_distance(p, a, b))
+                .fold(f64::INFINITY, f64::min)
+        };
+        let (a, b) = (nearest(own), nearest(other));
+        if a == f64::INFINITY {
+            0.0
+        } else if b == f64::INFINITY {
+            1.0
+        } else {
+            beta((1.0 - (a - b) / w).clamp(0.0, 1.0))
+        }
+    }
+
+    #[test]
+    fn pruned_nearest_bones_give_the_reference_kappa() {
+        let mut rng = SplitMix64::new(7);
+        let mut point = || {
+            DVec3::new(
+                rng.next_f64() * 4.0 - 2.0,
+                rng.next_f64() * 4.0 - 2.0,
+                rng.next_f64() * 4.0 - 2.0,
+            )
+        };
+        for case in 0..20 {
+            let mut bones = |n: usize| -> Vec<[DVec3; 2]> {
+                (0..n)
+                    .map(|k| {
+                        let a = point();
+                        // Every fifth bone is a point.
+                        [a, if k % 5 == 0 { a } else { point() }]
+                    })
+                    .collect()
+            };
+            let own = bones(case % 4);
+            let other = bones(case % 7);
+            let ownership = Ownership {
+                own_bones: own.iter().map(|&[a, b]| Segment::new(a, b)).collect(),
+                other_bones: other.iter().map(|&[a, b]| Segment::new(a, b)).collect(),
+                half_width: 0.3,
+            };
+            for _ in 0..200 {
+                let p = point();
+                let expected = reference_kappa(&own, &other, 0.3, p);
+                let got = ownership.at(p);
+                assert!(
+                    (got - expected).abs() < 1e-12,
+                    "case {case} at {p}: {got} vs {expected}"
+                );
+            }
+        }
     }
 }
