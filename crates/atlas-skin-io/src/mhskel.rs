@@ -141,6 +141,11 @@ mod tests {
                 r#"{"bones": {"a": {"head": "q", "parent": null}}, "joints": {}}"#.to_string(),
                 "joint \"q\" is not in \"joints\"",
             ),
+            (
+                r#"{"bones": {"a": {"head": "h", "tail": "t", "parent": null}}, "joints": {"h": [0]}}"#
+                    .to_string(),
+                "bone \"a\": joint \"t\" is not in \"joints\"",
+            ),
             ("{\"bones\": 1}".to_string(), ":1: invalid type"),
         ];
         for (i, (text, expected)) in cases.iter().enumerate() {
