@@ -1,16 +1,17 @@
 //! `atlas-skin animate`: a BVH motion put on a character whose skeleton is the motion's
 //! own comes back as a glTF animation that reproduces every joint's motion, passes the
-//! Khronos validator, and as an OBJ sequence with one posed mesh per frame.
+//! Khronos validator, and as an OBJ sequence with one posed mesh per frame; a joint map puts
+//! the same motion on a character whose joints have other names.
 
 mod support;
 
-use atlas_skin_corpus::{motion_path, node_check};
+use atlas_skin_corpus::{motion_path, node_check, CESIUMMAN};
 use atlas_skin_io::gltf::{write_skinned_glb, WriteOptions};
 use atlas_skin_io::{Character, TriangleMesh};
 use atlas_skin_runtime::{Rig, Trs, VertexWeights};
 use glam::{Mat4, Vec3};
 use std::path::Path;
-use support::{atlas_skin_ok, out_dir};
+use support::{atlas_skin, atlas_skin_ok, out_dir};
 
 /// A character made of one small tetrahedron at every joint of the BVH skeleton, each
 /// bound rigidly to its joint, written as a skinned glb.
@@ -112,4 +113,100 @@ fn obj_sequence_has_one_posed_mesh_per_frame() {
     let last = std::fs::read_to_string(dir.join(format!("sequence/walk_{frames:04}.obj")))
         .expect("last frame");
     assert_ne!(first, last, "the mesh moves");
+}
+
+#[test]
+fn a_joint_map_puts_the_motion_on_joints_named_otherwise() {
+    // CesiumMan's joints are named node*; it faces +x with +z up, so +y is its left.
+    let dir = out_dir("animate_joint_map");
+    let map = dir.join("cesiumman-cmu.json");
+    let pairs = [
+        ("node2", "Hips"),
+        ("node11", "Spine"),
+        ("node12", "Spine1"),
+        ("node19", "Neck"),
+        ("node20", "Head"),
+        ("node16", "LeftArm"),
+        ("node17", "LeftForeArm"),
+        ("node18", "LeftHand"),
+        ("node13", "RightArm"),
+        ("node14", "RightForeArm"),
+        ("node15", "RightHand"),
+        ("node7", "LeftUpLeg"),
+        ("node8", "LeftLeg"),
+        ("node9", "LeftFoot"),
+        ("node3", "RightUpLeg"),
+        ("node4", "RightLeg"),
+        ("node5", "RightFoot"),
+    ];
+    let json: serde_json::Map<String, serde_json::Value> = pairs
+        .iter()
+        .map(|&(character, motion)| (character.to_string(), motion.into()))
+        .collect();
+    std::fs::write(&map, serde_json::to_string_pretty(&json).unwrap()).unwrap();
+    let input = CESIUMMAN.input_path();
+    let motion = motion_path("walk.bvh");
+    let out = dir.join("walking.glb");
+    // `animate CESIUMMAN --bvh walk.bvh [--joint-map MAP] -o OUT`.
+    let run = |map: Option<&Path>, out: &Path| {
+        let mut args = vec![
+            Path::new("animate"),
+            &input,
+            Path::new("--bvh"),
+            &motion,
+            Path::new("-o"),
+            out,
+        ];
+        if let Some(map) = map {
+            args.extend([Path::new("--joint-map"), map]);
+        }
+        atlas_skin(&args)
+    };
+
+    let unmapped = run(None, &out);
+    assert!(!unmapped.status.success());
+    assert!(String::from_utf8_lossy(&unmapped.stderr).contains("no joint name in common"));
+    assert!(!out.exists());
+
+    let mapped = run(Some(&map), &out);
+    assert!(
+        mapped.status.success(),
+        "{}",
+        String::from_utf8_lossy(&mapped.stderr)
+    );
+    let animated = atlas_skin_io::load_character(&out, &Default::default()).expect("read output");
+    let rig = animated.rig.as_ref().expect("rig");
+    let clip = animated.clips.last().expect("the walk");
+    clip.validate(rig.len()).expect("valid animation");
+    // Every mapped joint turns during the walk.
+    let skeleton = animated.skeleton.as_ref().expect("skeleton");
+    for (character_joint, _) in pairs {
+        let node = rig.joint_nodes[skeleton.find(character_joint).unwrap()];
+        assert!(
+            clip.tracks.iter().any(|t| t.node == node),
+            "{character_joint} does not move"
+        );
+    }
+    for report in node_check("validate.mjs", &[&out]) {
+        assert_eq!(report["errors"], 0, "validator: {report}");
+    }
+
+    // A map naming a joint the character does not have names it and the map.
+    let bad = dir.join("bad-map.json");
+    std::fs::write(&bad, r#"{"nodeX": "Hips"}"#).unwrap();
+    let bad_out = dir.join("never.glb");
+    let output = run(Some(&bad), &bad_out);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        !output.status.success() && stderr.contains("\"nodeX\"") && stderr.contains("bad-map.json"),
+        "{stderr}"
+    );
+    assert!(!bad_out.exists());
+    std::fs::write(&bad, "[1, 2]").unwrap();
+    let output = run(Some(&bad), &bad_out);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("bad-map.json") && stderr.contains("JSON object"),
+        "{stderr}"
+    );
 }

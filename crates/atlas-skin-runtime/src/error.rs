@@ -60,4 +60,6 @@ pub enum RuntimeError {
         source_joint: String,
         target_joint: String,
     },
+    #[error("the joint map names {name:?}, which is not a joint of the {rig}")]
+    UnknownMappedJoint { name: String, rig: &'static str },
 }

@@ -1,5 +1,6 @@
-//! Moving a motion from one rig onto another whose joints have the same names but other
-//! rest orientations (a BVH capture onto a glTF character).
+//! Moving a motion from one rig onto another whose joints have the same names, or names
+//! paired by a joint map, but other rest orientations (a BVH capture onto a glTF
+//! character).
 //!
 //! Rest poses differ: a BVH joint's rest orientation is the identity (its bind pose is
 //! all rotations zero), a glTF joint's is whatever the artist's rest local rotations
@@ -51,26 +52,57 @@ pub fn normalized_name(name: &str) -> String {
 
 impl Retarget {
     /// Matches the target rig's skeleton joints to the source rig's skeleton joints by
-    /// [`normalized_name`] and precomputes both rest poses.
-    ///
-    /// Errors: either rig invalid ([`Rig::validate`]), or [`RuntimeError::NoCommonJoints`]
-    /// when no joint name matches.
+    /// [`normalized_name`] and precomputes both rest poses ([`Retarget::with_map`] with an
+    /// empty map).
     pub fn new(source: &Rig, target: &Rig) -> Result<Self, RuntimeError> {
+        Self::with_map(source, target, &[])
+    }
+
+    /// As [`Retarget::new`], but each (target joint, source joint) pair of `map`, by exact
+    /// name, is matched first; the other target joints are matched by
+    /// [`normalized_name`] among the source joints the map does not use.
+    ///
+    /// Errors: either rig invalid ([`Rig::validate`]),
+    /// [`RuntimeError::UnknownMappedJoint`] when the map names a joint a rig does not have,
+    /// [`RuntimeError::NoCommonJoints`] when nothing matches.
+    pub fn with_map(
+        source: &Rig,
+        target: &Rig,
+        map: &[(String, String)],
+    ) -> Result<Self, RuntimeError> {
         source.validate()?;
         target.validate()?;
+        let joint_named = |rig: &Rig, name: &str, which: &'static str| {
+            rig.joint_nodes
+                .iter()
+                .map(|&n| n as usize)
+                .find(|&n| rig.names[n] == name)
+                .ok_or_else(|| RuntimeError::UnknownMappedJoint {
+                    name: name.to_string(),
+                    rig: which,
+                })
+        };
         let mut source_of = vec![None; target.len()];
-        let mut matched = 0;
+        let mut mapped_sources = Vec::with_capacity(map.len());
+        for (target_name, source_name) in map {
+            let t = joint_named(target, target_name, "character")?;
+            let s = joint_named(source, source_name, "motion")?;
+            source_of[t] = Some(s);
+            mapped_sources.push(s);
+        }
         for &t in &target.joint_nodes {
+            if source_of[t as usize].is_some() {
+                continue;
+            }
             let wanted = normalized_name(&target.names[t as usize]);
-            let found = source
+            source_of[t as usize] = source
                 .joint_nodes
                 .iter()
-                .find(|&&s| normalized_name(&source.names[s as usize]) == wanted);
-            if let Some(&s) = found {
-                source_of[t as usize] = Some(s as usize);
-                matched += 1;
-            }
+                .map(|&s| s as usize)
+                .filter(|s| !mapped_sources.contains(s))
+                .find(|&s| normalized_name(&source.names[s]) == wanted);
         }
+        let matched = source_of.iter().flatten().count();
         if matched == 0 {
             let first = |rig: &Rig| rig.names.first().cloned().unwrap_or_default();
             return Err(RuntimeError::NoCommonJoints {
@@ -231,6 +263,49 @@ mod tests {
         // Each joint's world rotation is the delta applied to its own rest rotation.
         let expected = Quat::from_rotation_z(FRAC_PI_2) * Quat::from_rotation_y(-1.2);
         assert!(rotation(&world[1]).angle_between(expected) < 1e-4);
+    }
+
+    #[test]
+    fn a_joint_map_pairs_joints_whose_names_differ() {
+        let source = chain(["Hips", "Spine"], 1.0, [Quat::IDENTITY; 2]);
+        let target = chain(["node2", "node11"], 1.0, [Quat::IDENTITY; 2]);
+        assert!(Retarget::new(&source, &target).is_err());
+        let map = |pairs: &[(&str, &str)]| -> Vec<(String, String)> {
+            pairs.iter().map(|&(t, s)| (t.into(), s.into())).collect()
+        };
+        let mut retarget = Retarget::with_map(
+            &source,
+            &target,
+            &map(&[("node2", "Hips"), ("node11", "Spine")]),
+        )
+        .unwrap();
+        assert_eq!(retarget.matched_count(), 2);
+        let mut source_local = source.rest.clone();
+        source_local[1].rotation = Quat::from_rotation_z(0.5);
+        let mut target_local = target.rest.clone();
+        retarget.apply(&source, &source_local, &target, &mut target_local);
+        assert!(
+            target_local[1]
+                .rotation
+                .angle_between(Quat::from_rotation_z(0.5))
+                < 1e-5
+        );
+        // A map entry wins over a name match, and names a rig does not have are errors.
+        let swapped = chain(["Spine", "Hips"], 1.0, [Quat::IDENTITY; 2]);
+        let crossed = Retarget::with_map(&source, &swapped, &map(&[("Spine", "Hips")])).unwrap();
+        assert_eq!(crossed.source_of, vec![Some(0), None]);
+        for (pairs, name, rig) in [
+            (&[("nodeX", "Hips")][..], "nodeX", "character"),
+            (&[("node2", "Chest")][..], "Chest", "motion"),
+        ] {
+            assert_eq!(
+                Retarget::with_map(&source, &target, &map(pairs)).unwrap_err(),
+                RuntimeError::UnknownMappedJoint {
+                    name: name.into(),
+                    rig
+                }
+            );
+        }
     }
 
     #[test]

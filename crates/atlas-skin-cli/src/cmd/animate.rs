@@ -11,7 +11,6 @@ use crate::input::InputArgs;
 use anyhow::{Context, Result};
 use atlas_skin_io::gltf::{write_skinned_glb, WriteOptions};
 use atlas_skin_io::Character;
-use atlas_skin_runtime::retarget::Retarget;
 use atlas_skin_runtime::{Clip, Interpolation, Property, SkinningMethod, Track, Trs};
 use std::path::{Path, PathBuf};
 
@@ -20,9 +19,14 @@ use std::path::{Path, PathBuf};
 pub struct Args {
     #[command(flatten)]
     pub input: InputArgs,
-    /// The motion: a BVH file whose joint names match the character's.
+    /// The motion: a BVH file whose joint names match the character's (or are paired with
+    /// them by --joint-map).
     #[arg(long)]
     pub bvh: PathBuf,
+    /// JSON object pairing character joints (keys) with BVH joints (values) whose names
+    /// differ; other joints are matched by name.
+    #[arg(long, value_name = "MAP.json")]
+    pub joint_map: Option<PathBuf>,
     /// Dual quaternion skinning for an OBJ sequence (a glb is skinned by its viewer).
     #[arg(long)]
     pub dqs: bool,
@@ -34,7 +38,7 @@ pub struct Args {
 
 pub fn run(args: Args) -> Result<()> {
     let character = args.input.load_skinned()?;
-    let motion = BvhMotion::read(&args.bvh)?;
+    let motion = BvhMotion::read(&args.bvh, args.joint_map.as_deref())?;
     let is_obj = args
         .output
         .extension()
@@ -53,12 +57,12 @@ pub fn run(args: Args) -> Result<()> {
     }
 }
 
-/// The character at `input` with the BVH motion at `bvh` as a glTF animation, as the
-/// bytes of a `.glb` (for the HTML report).
-pub fn animate_glb_bytes(input: &Path, bvh: &Path) -> Result<Vec<u8>> {
+/// The character at `input` with the BVH motion at `bvh` (and the joint map at
+/// `joint_map`) as a glTF animation, as the bytes of a `.glb` (for the HTML report).
+pub fn animate_glb_bytes(input: &Path, bvh: &Path, joint_map: Option<&Path>) -> Result<Vec<u8>> {
     let character = atlas_skin_io::load_character(input, &Default::default())
         .with_context(|| format!("cannot load {}", input.display()))?;
-    let motion = BvhMotion::read(bvh)?;
+    let motion = BvhMotion::read(bvh, joint_map)?;
     let (weights, options) = animation_options(&character, &motion)?;
     // The writer writes files; a private temporary file turns it into bytes.
     let temporary = std::env::temp_dir().join(format!(
@@ -101,8 +105,7 @@ fn animation_options<'a>(
 /// whose local translation changes, one LINEAR key per BVH frame.
 pub fn retargeted_clip(posable: &Posable, motion: &BvhMotion) -> Result<Clip> {
     let rig = &posable.rig;
-    let mut retarget =
-        Retarget::new(&motion.rig, rig).context("cannot map the motion onto the character")?;
+    let mut retarget = motion.retarget(rig)?;
     let times = motion.frame_times().to_vec();
     let mut frames: Vec<Vec<Trs>> = Vec::with_capacity(times.len());
     let mut local = rig.rest.clone();
@@ -167,8 +170,7 @@ fn write_obj_sequence(
 ) -> Result<()> {
     let posable = Posable::new(character)?;
     let rig = &posable.rig;
-    let mut retarget =
-        Retarget::new(&motion.rig, rig).context("cannot map the motion onto the character")?;
+    let mut retarget = motion.retarget(rig)?;
     let stem = out.with_extension("");
     let mut local = rig.rest.clone();
     for (frame, &time) in motion.frame_times().iter().enumerate() {

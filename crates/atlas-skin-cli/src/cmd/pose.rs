@@ -40,6 +40,10 @@ pub struct Args {
     /// Frame of the BVH motion (0 = first), with --bvh.
     #[arg(long, default_value_t = 0, requires = "bvh")]
     pub frame: usize,
+    /// JSON object pairing character joints (keys) with BVH joints (values) whose names
+    /// differ, with --bvh; other joints are matched by name.
+    #[arg(long, value_name = "MAP.json", requires = "bvh")]
+    pub joint_map: Option<PathBuf>,
     /// Dual quaternion skinning instead of linear blend skinning.
     #[arg(long)]
     pub dqs: bool,
@@ -71,7 +75,7 @@ pub fn run(args: Args) -> Result<()> {
     let posable = Posable::new(&character)?;
     let local = match (&args.source.anim, &args.source.bvh, &args.source.pose) {
         (Some(name), _, _) => posable.sample_clip(find_clip(&character.clips, name)?, args.time)?,
-        (_, Some(bvh), _) => posable.bvh_frame(bvh, args.frame)?,
+        (_, Some(bvh), _) => posable.bvh_frame(bvh, args.joint_map.as_deref(), args.frame)?,
         (_, _, Some(pose)) => posable.with_rotations(&read_pose_file(pose, &posable.rig)?),
         _ => {
             let seed = args.source.random.context("no pose source given")?;
@@ -151,12 +155,19 @@ impl Posable {
         Ok(local)
     }
 
-    /// Frame `frame` of the BVH motion at `path`, retargeted onto the rig.
-    pub fn bvh_frame(&self, path: &Path, frame: usize) -> Result<Vec<Trs>> {
-        let motion = BvhMotion::read(path)?;
+    /// Frame `frame` of the BVH motion at `path`, retargeted onto the rig (with the joint
+    /// map at `joint_map`, if any).
+    pub fn bvh_frame(
+        &self,
+        path: &Path,
+        joint_map: Option<&Path>,
+        frame: usize,
+    ) -> Result<Vec<Trs>> {
+        let motion = BvhMotion::read(path, joint_map)?;
         let time = motion.frame_time(frame)?;
-        let mut retarget = Retarget::new(&motion.rig, &self.rig)
-            .with_context(|| format!("cannot map {} onto the character", path.display()))?;
+        let mut retarget = motion
+            .retarget(&self.rig)
+            .with_context(|| format!("cannot put {} on the character", path.display()))?;
         let mut local = self.rig.rest.clone();
         retarget.apply(&motion.rig, &motion.sample(time), &self.rig, &mut local);
         Ok(local)
@@ -224,19 +235,48 @@ impl Posable {
     }
 }
 
-/// A BVH motion: its rig (one node per joint) and its clip.
+/// A BVH motion: its rig (one node per joint) and its clip, and the joint map that pairs
+/// a character's joints with its joints.
 pub struct BvhMotion {
     pub rig: Rig,
     pub clip: Clip,
+    /// (character joint, motion joint) pairs from `--joint-map`, matched before names, and
+    /// the file they come from.
+    pub joint_map: Vec<(String, String)>,
+    pub joint_map_path: Option<PathBuf>,
 }
 
 impl BvhMotion {
-    pub fn read(path: &Path) -> Result<Self> {
+    /// Reads the BVH at `path` and, when given, the joint map at `joint_map`: a JSON object
+    /// whose keys are character joints and values motion joints (docs/formats.md).
+    pub fn read(path: &Path, joint_map_path: Option<&Path>) -> Result<Self> {
         let (_, rig, clip) = atlas_skin_io::bvh::read_motion(path)
             .with_context(|| format!("cannot read motion {}", path.display()))?;
         clip.validate(rig.len())
             .with_context(|| format!("invalid motion in {}", path.display()))?;
-        Ok(Self { rig, clip })
+        let joint_map = match joint_map_path {
+            Some(map) => read_joint_map(map)?,
+            None => Vec::new(),
+        };
+        Ok(Self {
+            rig,
+            clip,
+            joint_map,
+            joint_map_path: joint_map_path.map(Path::to_path_buf),
+        })
+    }
+
+    /// The mapping of this motion onto `rig` ([`Retarget::with_map`]).
+    pub fn retarget(&self, rig: &Rig) -> Result<Retarget> {
+        Retarget::with_map(&self.rig, rig, &self.joint_map).with_context(|| {
+            match &self.joint_map_path {
+                Some(map) => format!(
+                    "cannot map the motion onto the character with {}",
+                    map.display()
+                ),
+                None => "cannot map the motion onto the character".to_string(),
+            }
+        })
     }
 
     /// Key times of the frames (every track of a BVH clip has one key per frame).
@@ -420,6 +460,20 @@ fn obj_text(posed: &PosedMesh, triangles: &[[u32; 3]]) -> String {
         let _ = writeln!(text, "f {a}//{a} {b}//{b} {c}//{c}");
     }
     text
+}
+
+/// The pairs of the joint map at `path` (a JSON object of strings), in key order.
+fn read_joint_map(path: &Path) -> Result<Vec<(String, String)>> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("cannot read joint map {}", path.display()))?;
+    let map: std::collections::BTreeMap<String, String> = serde_json::from_str(&text)
+        .with_context(|| {
+            format!(
+                "{}: a joint map is a JSON object from character joint names to motion joint names",
+                path.display()
+            )
+        })?;
+    Ok(map.into_iter().collect())
 }
 
 #[cfg(test)]

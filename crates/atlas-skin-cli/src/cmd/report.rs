@@ -18,6 +18,10 @@ pub struct Args {
     /// `atlas-skin animate`) and embedded as a glTF animation.
     #[arg(long, value_name = "FILE")]
     pub bvh: Option<PathBuf>,
+    /// JSON object pairing character joints (keys) with BVH joints (values) whose names
+    /// differ, with --bvh.
+    #[arg(long, value_name = "MAP.json", requires = "bvh")]
+    pub joint_map: Option<PathBuf>,
     /// The HTML file to write.
     #[arg(short, long, value_name = "REPORT.html")]
     pub output: PathBuf,
@@ -26,8 +30,10 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<()> {
     refuse_overwrite(&args.input, &args.output)?;
     let glb = match &args.bvh {
-        Some(bvh) => crate::cmd::animate::animate_glb_bytes(&args.input, bvh)
-            .with_context(|| format!("putting the motion {} on the character", bvh.display()))?,
+        Some(bvh) => {
+            crate::cmd::animate::animate_glb_bytes(&args.input, bvh, args.joint_map.as_deref())
+                .with_context(|| format!("putting the motion {} on the character", bvh.display()))?
+        }
         None => std::fs::read(&args.input)
             .with_context(|| format!("reading {}", args.input.display()))?,
     };
