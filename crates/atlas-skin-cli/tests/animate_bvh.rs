@@ -11,7 +11,7 @@ use atlas_skin_io::{Character, TriangleMesh};
 use atlas_skin_runtime::{Rig, Trs, VertexWeights};
 use glam::{Mat4, Vec3};
 use std::path::Path;
-use support::{atlas_skin, atlas_skin_ok, out_dir};
+use support::{atlas_skin, atlas_skin_ok, obj_positions, out_dir};
 
 /// A character made of one small tetrahedron at every joint of the BVH skeleton, each
 /// bound rigidly to its joint, written as a skinned glb.
@@ -190,6 +190,41 @@ fn a_joint_map_puts_the_motion_on_joints_named_otherwise() {
     for report in node_check("validate.mjs", &[&out]) {
         assert_eq!(report["errors"], 0, "validator: {report}");
     }
+
+    // The same map serves `pose --bvh` (one frame) and `report --bvh` (the HTML page).
+    let pose = |frame: &str, obj: &Path| {
+        atlas_skin_ok(&[
+            Path::new("pose"),
+            &input,
+            Path::new("--bvh"),
+            &motion,
+            Path::new("--frame"),
+            Path::new(frame),
+            Path::new("--joint-map"),
+            &map,
+            Path::new("-o"),
+            obj,
+        ]);
+        obj_positions(obj)
+    };
+    let (early, late) = (dir.join("frame0.obj"), dir.join("frame60.obj"));
+    assert_ne!(
+        pose("0", &early),
+        pose("60", &late),
+        "the walk moves the mesh"
+    );
+    let html = dir.join("walking.html");
+    atlas_skin_ok(&[
+        Path::new("report"),
+        &input,
+        Path::new("--bvh"),
+        &motion,
+        Path::new("--joint-map"),
+        &map,
+        Path::new("-o"),
+        &html,
+    ]);
+    assert!(std::fs::metadata(&html).expect("report written").len() > 100_000);
 
     // A map naming a joint the character does not have names it and the map.
     let bad = dir.join("bad-map.json");
