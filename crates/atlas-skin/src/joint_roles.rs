@@ -1,15 +1,17 @@
 //! Which joints get a boundary (Lu et al. 2008 §3.1, and METHOD.md "Measured on real rigs").
 //!
 //! The rules, in the order they are applied to joint J at bind position p_J:
-//! 1. Forbidden by the user: no boundary. Forced by the user: a boundary, whatever follows.
+//! 1. Forbidden by the user: no boundary, and no skin at all ([`JointPlan::Exclude`]).
+//!    Forced by the user: a boundary, whatever follows.
 //! 2. A root has no upper bone to cut: its region is the root region. A joint whose bones
 //!    all have zero length has no direction to cut across: no boundary.
 //! 3. A joint lies outside the mesh and owns no geometry when it is farther from the
 //!    surface than `outside_ratio` × its longest bone and outside it: most of six rays from
 //!    it (±x, ±y, ±z, slightly turned) first meet the surface from outside, or not at all.
-//!    Then: no boundary. A joint near the surface (a face bone in an eye socket) keeps its
-//!    boundary: the skin around it is its to move. A winding number is not used: it fails
-//!    on open and multi-piece meshes; the ray vote needs only a locally outward surface.
+//!    Then: no boundary and no skin ([`JointPlan::Exclude`]). A joint near the surface (a
+//!    face bone in an eye socket) keeps its boundary: the skin around it is its to move. A
+//!    winding number is not used: it fails on open and multi-piece meshes; the ray vote
+//!    needs only a locally outward surface.
 //! 4. A branching joint (two or more children) on the skeleton's mirror plane (pelvis,
 //!    chest, head, jaw). The paper gives it no boundary; here (METHOD.md, "extensions") it
 //!    gets one when it owns a part of the trunk. Nearer to the surface than a quarter of its
@@ -20,11 +22,14 @@
 //!    whose bones run forward to the upper lip, takes the lip the artist leaves to the
 //!    head: bleeding .020 → .026 without this rule.) Otherwise where its branches start is
 //!    judged against its section's diameter D = 2 × surface distance. Most child bones (the
-//!    median) shorter than D: it sits at the junction, its children's boundaries enclose all
-//!    around it, it owns no geometry: no boundary. Some child bone shorter than D: any plane
-//!    through it slices that branch's root: a soft boundary only. Otherwise its cut is
-//!    searched like any other but placed after all others
-//!    ([`JointFrame::on_mirror_plane`]), and it is soft when no clean cut fits.
+//!    median) shorter than D: it sits at the junction (a chest between shoulders and neck),
+//!    its children's boundaries enclose most of it, so no cut fits; but the trunk below them
+//!    bends with it, as artists weight it: a soft boundary only (its branches take their
+//!    parts from the whole chain below it, see [`crate::weights`]; measured on cesiumman,
+//!    weight L1 .212 → .181, and on riggedfigure .552 → .434, against no boundary). Some
+//!    child bone shorter than D: any plane through it slices that branch's root: a soft
+//!    boundary only. Otherwise its cut is searched like any other but placed after all
+//!    others ([`JointFrame::on_mirror_plane`]), and it is soft when no clean cut fits.
 //!    Off the plane (a clavicle with a breast bone, a wrist with five finger bones) a
 //!    branching joint is cut like a chain joint whose lower bone is the mean of its unit
 //!    child directions — for a wrist, the average finger direction.

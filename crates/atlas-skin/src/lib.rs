@@ -2,7 +2,7 @@
 //! (Lu, Hétroy, Gérot, Thibert, INRIA RR-6406, 2008).
 //!
 //! The pipeline, one module per stage:
-//! mesh analysis ([`weld`], [`topology`], [`winding`]) → cuts at joints (§3.1) →
+//! mesh analysis ([`weld`](mod@weld), [`topology`], [`winding`]) → cuts at joints (§3.1) →
 //! regions (§3.2) → surface distances and overlaps (§3.3) → weights (§4, §5).
 
 pub mod blend;

@@ -31,13 +31,12 @@
 //!    carries c's part past its plane where such a bone is the nearest: a chin that hangs
 //!    below the plane of the head joint but lies on the jaw bone moves with the head.
 //!    The region's joints form a tree (each soft joint under its nearest ancestor among
-//!    them that does not branch, the bound joint at the root: a branching joint's plane
-//!    says nothing about where its branches go, so a shoulder hangs under the spine, not
-//!    under the chest beside it). Visiting the nodes parents first, the children c of a
-//!    node take, with S = Σ_c s_c, the share min(1, S) of the mass of every node on the
-//!    chain from the root to that node; child c receives the pooled amount times
-//!    s_c / max(1, S). (Taking from the whole chain rather than the node alone lets the
-//!    head take the chin from the neck where the upper neck's plane does not reach it.)
+//!    them, the bound joint at the root). Visiting the nodes parents first, the children c
+//!    of a node take, with S = Σ_c s_c, the share min(1, S) of the mass of every node on
+//!    the chain from the root to that node; child c receives the pooled amount times
+//!    s_c / max(1, S). Taking from the whole chain rather than the node alone lets the
+//!    head take the chin from the neck where the upper neck's plane does not reach it, and
+//!    a shoulder take its arm from the spine where the chest's plane, beside it, does not.
 //!    Masses are non-negative, sum to the region's weight ω, and are continuous.
 //!
 //!    The child side is not a half-space: it is the set of vertices reached *along the
@@ -594,7 +593,6 @@ fn region_trees(
     skeleton: &Skeleton,
     softs: &[SoftSide],
 ) -> Vec<RegionTree> {
-    let children = skeleton.children();
     decomposition
         .regions
         .iter()
@@ -621,7 +619,7 @@ fn region_trees(
                     match ancestor {
                         None => break 0,
                         Some(a) => match tree.joints.iter().position(|&j| j as usize == a) {
-                            Some(p) if p == 0 || children[a].len() < 2 => break p,
+                            Some(p) => break p,
                             _ => ancestor = skeleton.parent(a),
                         },
                     }
