@@ -1,8 +1,9 @@
 //! The HTML report in Debian's headless Chromium (tests/js/viewer.mjs with playwright-core):
 //! no console error, no network request, a picture that is not blank and that changes with a
 //! joint slider, the heat map and the animation time; the LBS/DQS switch; GPU skinning equal
-//! to the runtime's reference; on the demo character and MakeHuman skinned by `atlas-skin
-//! skin --html`, on glTF files as they are, and with a BVH motion.
+//! to the runtime's reference; dragging a joint to pose it; on the demo character and
+//! MakeHuman skinned by `atlas-skin skin --html`, on glTF files as they are, and with a BVH
+//! motion.
 
 mod support;
 
@@ -117,10 +118,32 @@ fn assert_gpu_skinning_matches_reference(checks: &serde_json::Value) {
     }
 }
 
+/// Dragging a joint poses it (tests/js/viewer.mjs, `dragJoint`): the pointer pressed on a
+/// joint with children and moved 80 px across its bone turns the joint by 90° about the view
+/// direction (the bone follows the pointer) without moving the camera; the picture and the
+/// joint's sliders change, and "Reset pose" undoes it. Fails when dragging does nothing.
+fn assert_dragging_a_joint_poses_it(checks: &serde_json::Value) {
+    let number = |key: &str| checks[key].as_f64().unwrap_or(f64::NAN);
+    assert!(
+        checks["drag_joint"].is_string(),
+        "no joint was dragged: {checks:#}"
+    );
+    assert_eq!(checks["drag_camera_unchanged"], true, "{checks:#}");
+    assert!(
+        (number("drag_rotation_degrees") - 90.0).abs() < 10.0,
+        "{checks:#}"
+    );
+    assert!(number("drag_aim_error_degrees") < 10.0, "{checks:#}");
+    assert!(number("drag_changed_fraction") > 0.002, "{checks:#}");
+    assert_eq!(checks["drag_sliders_changed"], true, "{checks:#}");
+    assert!(number("drag_reset_degrees") < 1e-6, "{checks:#}");
+}
+
 #[test]
 fn cesiumman_without_a_report_shows_the_file_weights() {
     let checks = check_in_browser("cesiumman", &CESIUMMAN.input_path(), None);
     assert_gpu_skinning_matches_reference(&checks);
+    assert_dragging_a_joint_poses_it(&checks);
     assert_eq!(checks["animations"], 1);
     // The bent joint's blend zone looks different under dual quaternions.
     assert!(
@@ -169,6 +192,7 @@ fn cesiumman_with_a_report_shows_cuts_tables_and_warnings() {
 fn riggedfigure_opens_and_poses() {
     let checks = check_in_browser("riggedfigure", &RIGGEDFIGURE.input_path(), None);
     assert_gpu_skinning_matches_reference(&checks);
+    assert_dragging_a_joint_poses_it(&checks);
     assert_eq!(checks["animations"], 1);
 }
 
@@ -289,6 +313,7 @@ fn the_demo_character_skinned_by_the_project_shows_its_cuts_and_plays_a_bvh_moti
     assert!(checks["curve_segments"].as_u64() > Some(0), "{checks:#}");
     assert_eq!(checks["report_tables"], 4);
     assert_gpu_skinning_matches_reference(&checks);
+    assert_dragging_a_joint_poses_it(&checks);
 
     let walk = motion_path("walk.bvh");
     let animated = dir.join("demo_walk.html");
@@ -322,6 +347,7 @@ fn makehuman_skinned_by_the_project_opens_with_its_163_joints() {
     let checks = drive("makehuman", &html);
     assert!(checks["curve_segments"].as_u64() > Some(0), "{checks:#}");
     assert_gpu_skinning_matches_reference(&checks);
+    assert_dragging_a_joint_poses_it(&checks);
 }
 
 #[test]

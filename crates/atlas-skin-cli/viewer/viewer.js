@@ -51,6 +51,7 @@
         -vec3.dot(x, eye), -vec3.dot(y, eye), -vec3.dot(z, eye), 1,
       ]);
     },
+    columnLengths: (m) => [0, 1, 2].map((c) => Math.hypot(m[c * 4], m[c * 4 + 1], m[c * 4 + 2]) || 1),
     transformPoint: (m, p) => [
       m[0] * p[0] + m[4] * p[1] + m[8] * p[2] + m[12],
       m[1] * p[0] + m[5] * p[1] + m[9] * p[2] + m[13],
@@ -80,6 +81,37 @@
     axisAngle(axis, radians) {
       const s = Math.sin(radians / 2);
       return [axis[0] * s, axis[1] * s, axis[2] * s, Math.cos(radians / 2)];
+    },
+    conjugate: (q) => [-q[0], -q[1], -q[2], q[3]],
+    // v rotated by the unit quaternion q = (u, w): v + w t + u × t with t = 2 u × v.
+    rotate(q, v) {
+      const u = [q[0], q[1], q[2]];
+      const t = vec3.cross(u, v).map((c) => 2 * c);
+      const ut = vec3.cross(u, t);
+      return [0, 1, 2].map((c) => v[c] + q[3] * t[c] + ut[c]);
+    },
+    // The joint sliders' angles [x, y, z] (degrees) as the rotation Rz(z) Ry(y) Rx(x).
+    fromEulerDegrees(degrees) {
+      const toRad = Math.PI / 180;
+      return [[0, 0, 1], [0, 1, 0], [1, 0, 0]]
+        .map((axis, k) => quat.axisAngle(axis, degrees[2 - k] * toRad))
+        .reduce((a, b) => quat.multiply(a, b));
+    },
+    // Inverse of fromEulerDegrees: with R = Rz(z) Ry(y) Rx(x), R20 = -sin y, R21 / R22 = tan x
+    // and R10 / R00 = tan z; at y = ±90° only x ∓ z is defined: z = 0, x = atan2(-R12, R11).
+    // Angles in (-180°, 180°], y in [-90°, 90°].
+    toEulerDegrees(q) {
+      const [x, y, z, w] = q;
+      const toDeg = 180 / Math.PI;
+      const sinY = Math.max(-1, Math.min(1, -2 * (x * z - y * w)));
+      if (Math.abs(sinY) > 1 - 1e-9) {
+        return [Math.atan2(-2 * (y * z - x * w), 1 - 2 * (x * x + z * z)) * toDeg, Math.asin(sinY) * toDeg, 0];
+      }
+      return [
+        Math.atan2(2 * (y * z + x * w), 1 - 2 * (x * x + y * y)) * toDeg,
+        Math.asin(sinY) * toDeg,
+        Math.atan2(2 * (x * y + z * w), 1 - 2 * (y * y + z * z)) * toDeg,
+      ];
     },
     slerp(a, b, t) {
       let d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
@@ -212,18 +244,17 @@
     return { nodes, order };
   }
 
+  // The node's own transform before the user's rotation: its matrix or its (animated) T R S.
+  const baseTransform = (node) => node.matrix || mat4.fromTrs(node.pose.t, node.pose.r, node.pose.s);
+
   // local = (matrix | T R S) * R_user, R_user = Rz Ry Rx of the joint's slider angles (degrees).
   function updateWorld(scene) {
     for (const i of scene.order) {
       const node = scene.nodes[i];
-      const base = node.matrix || mat4.fromTrs(node.pose.t, node.pose.r, node.pose.s);
+      const base = baseTransform(node);
       let local = base;
       if (node.user[0] || node.user[1] || node.user[2]) {
-        const toRad = Math.PI / 180;
-        const q = [[0, 0, 1], [0, 1, 0], [1, 0, 0]]
-          .map((axis, k) => quat.axisAngle(axis, node.user[2 - k] * toRad))
-          .reduce((a, b) => quat.multiply(a, b));
-        local = mat4.multiply(base, mat4.fromTrs([0, 0, 0], q, [1, 1, 1]));
+        local = mat4.multiply(base, mat4.fromTrs([0, 0, 0], quat.fromEulerDegrees(node.user), [1, 1, 1]));
       }
       node.world = node.parent >= 0 ? mat4.multiply(scene.nodes[node.parent].world, local) : local;
     }
@@ -391,7 +422,7 @@
   function updatePalette(scene, skin) {
     skin.joints.forEach((nodeIndex, j) => {
       const m = mat4.multiply(scene.nodes[nodeIndex].world, skin.inverseBind(j));
-      const scale = [0, 1, 2].map((c) => Math.hypot(m[c * 4], m[c * 4 + 1], m[c * 4 + 2]) || 1);
+      const scale = mat4.columnLengths(m);
       const real = quat.fromMatrix(m, scale);
       const dual = quat.multiply([m[12], m[13], m[14], 0], real).map((x) => 0.5 * x);
       const row = skin.palette.subarray(j * 28, j * 28 + 28);
@@ -687,7 +718,11 @@
     const curves = curveGeometry([...boundaries.cuts, ...boundaries.planes], main);
     const cutVertices = 2 * boundaries.cuts.reduce((n, c) => n + c.length, 0);
     const curveGpu = createVertexArray(gl, { a_position: [curves.positions, 3], a_joints0: [curves.joints0, 4], a_weights0: [curves.weights0, 4] });
-    const bones = mainSkin.joints.map((n, j) => [j, mainSkin.joints.indexOf(scene.nodes[n].parent)]).filter(([, p]) => p >= 0);
+    // Skin joint of each joint's parent node (-1 for a root) and the bones (joint, parent).
+    const parentJoint = mainSkin.joints.map((n) => mainSkin.joints.indexOf(scene.nodes[n].parent));
+    const bones = parentJoint.map((p, j) => [j, p]).filter(([, p]) => p >= 0);
+    const childJoints = parentJoint.map(() => []);
+    bones.forEach(([j, p]) => childJoints[p].push(j));
     const skeletonPoints = new Float32Array(mainSkin.joints.length * 3);
     const skeletonLines = new Float32Array(bones.length * 6);
     const skeletonGpu = createVertexArray(gl, { a_position: [skeletonLines, 3] });
@@ -720,6 +755,8 @@
       radius: Math.max(1e-6, Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) / 2),
       yaw: 0.5, pitch: 0.15, zoom: 1,
     };
+    // Unit vector from the camera's target towards the eye.
+    const viewDirection = () => [Math.cos(camera.pitch) * Math.sin(camera.yaw), Math.sin(camera.pitch), Math.cos(camera.pitch) * Math.cos(camera.yaw)];
     const state = { joint: 0, heat: false, dqs: false, skeleton: true, curves: true, animation: -1, time: 0, playing: false };
     let viewProjection = mat4.identity();
 
@@ -739,7 +776,7 @@
       gl.enable(gl.DEPTH_TEST);
 
       const distance = (camera.radius / Math.tan(Math.PI / 8)) * camera.zoom;
-      const direction = [Math.cos(camera.pitch) * Math.sin(camera.yaw), Math.sin(camera.pitch), Math.cos(camera.pitch) * Math.cos(camera.yaw)];
+      const direction = viewDirection();
       const eye = camera.target.map((t, c) => t + distance * direction[c]);
       const near = Math.max(distance - 4 * camera.radius, distance * 0.01);
       viewProjection = mat4.multiply(mat4.perspective(Math.PI / 4, width / height, near, distance + 4 * camera.radius), mat4.lookAt(eye, camera.target, [0, 1, 0]));
@@ -838,7 +875,7 @@
       const user = scene.nodes[mainSkin.joints[j]].user;
       axes.forEach((a, k) => {
         $(`rot-${a}`).value = String(user[k]);
-        $(`rot-${a}-value`).textContent = `${user[k]}°`;
+        $(`rot-${a}-value`).textContent = `${Math.round(user[k])}°`;
       });
       requestRender();
     }
@@ -890,16 +927,19 @@
       requestRender();
     });
 
-    // ---- camera: drag to orbit, shift/right drag to pan, wheel to zoom, click to pick ----
+    // ---- camera: drag to orbit, shift/right drag to pan, wheel to zoom, click to pick;
+    // ---- drag a joint (skeleton shown) to pose it ----
     const tip = $('tip');
-    // Window coordinates of joint j in the last frame (null behind the eye).
-    const projectJoint = (j) => {
+    // Window coordinates of the world point p seen by the last frame's camera (null behind
+    // the eye).
+    const projectPoint = (p) => {
       const rect = canvas.getBoundingClientRect();
-      const p = scene.nodes[mainSkin.joints[j]].world;
-      const clip = [0, 1, 3].map((r) => viewProjection[r] * p[12] + viewProjection[4 + r] * p[13] + viewProjection[8 + r] * p[14] + viewProjection[12 + r]);
+      const clip = [0, 1, 3].map((r) => viewProjection[r] * p[0] + viewProjection[4 + r] * p[1] + viewProjection[8 + r] * p[2] + viewProjection[12 + r]);
       if (clip[2] <= 0) return null;
       return { x: rect.left + ((clip[0] / clip[2] + 1) / 2) * rect.width, y: rect.top + ((1 - clip[1] / clip[2]) / 2) * rect.height };
     };
+    // Window coordinates of joint j in the last computed pose.
+    const projectJoint = (j) => projectPoint(scene.nodes[mainSkin.joints[j]].world.subarray(12, 15));
     const jointAt = (x, y) => {
       let best = -1;
       let bestDistance = 12;
@@ -913,10 +953,46 @@
       });
       return best;
     };
+    // Drag to pose, a screen-plane rotation: the dragged joint turns about the view direction
+    // d through its posed position by the angle φ swept, around its projection J, from a
+    // reference point R to the pointer P (window y points down, hence the sign):
+    //   φ = -atan2((R - J) × (P - J), (R - J) · (P - J)).
+    // R is the projection of the mean of the joint's children, so that the child side points
+    // at the pointer; for a leaf, or children projecting within POSE_DEAD_ZONE pixels of J,
+    // R is the previous pointer position, so that the joint turns with the pointer's sweep.
+    // A pointer within POSE_DEAD_ZONE pixels of J gives no direction and is ignored. The world
+    // rotation q_d(φ) is composed onto the slider rotation in the frame F, the rotation of
+    // (parent world · base):  q_user ← (F⁻¹ q_d(φ) F) q_user = q_{F⁻¹ d}(φ) q_user.
+    const POSE_DEAD_ZONE = 8;
+    function turnJointTowards(drag, pointer) {
+      updateWorld(scene);
+      const node = scene.nodes[mainSkin.joints[drag.joint]];
+      const centre = projectJoint(drag.joint);
+      const away = (q) => q && Math.hypot(q.x - centre.x, q.y - centre.y) >= POSE_DEAD_ZONE;
+      if (!centre || !away(pointer)) return;
+      const children = childJoints[drag.joint].map((c) => scene.nodes[mainSkin.joints[c]].world);
+      const child = children.length ? projectPoint([12, 13, 14].map((i) => children.reduce((s, m) => s + m[i], 0) / children.length)) : null;
+      const reference = away(child) ? child : drag.previous;
+      drag.previous = pointer;
+      if (!reference) return;
+      const r = [reference.x - centre.x, reference.y - centre.y];
+      const p = [pointer.x - centre.x, pointer.y - centre.y];
+      const angle = -Math.atan2(r[0] * p[1] - r[1] * p[0], r[0] * p[0] + r[1] * p[1]);
+      const parentWorld = node.parent >= 0 ? scene.nodes[node.parent].world : mat4.identity();
+      const frame = mat4.multiply(parentWorld, baseTransform(node));
+      const axis = quat.rotate(quat.conjugate(quat.fromMatrix(frame, mat4.columnLengths(frame))), viewDirection());
+      node.user = quat.toEulerDegrees(quat.multiply(quat.axisAngle(axis, angle), quat.fromEulerDegrees(node.user)));
+      selectJoint(drag.joint);
+    }
+
+    // `joint`: the joint being posed, -1 when the drag moves the camera.
     let drag = null;
     canvas.addEventListener('contextmenu', (event) => event.preventDefault());
     canvas.addEventListener('pointerdown', (event) => {
-      drag = { x: event.clientX, y: event.clientY, moved: false, pan: event.shiftKey || event.button === 2 };
+      const pan = event.shiftKey || event.button === 2;
+      const joint = !pan && event.button === 0 && state.skeleton ? jointAt(event.clientX, event.clientY) : -1;
+      drag = { x: event.clientX, y: event.clientY, moved: false, pan, joint, previous: null };
+      if (joint >= 0) selectJoint(joint);
       canvas.setPointerCapture(event.pointerId);
     });
     canvas.addEventListener('pointermove', (event) => {
@@ -926,7 +1002,9 @@
         drag.moved = drag.moved || Math.abs(dx) + Math.abs(dy) > 3;
         drag.x = event.clientX;
         drag.y = event.clientY;
-        if (drag.pan) {
+        if (drag.joint >= 0) {
+          turnJointTowards(drag, { x: event.clientX, y: event.clientY });
+        } else if (drag.pan) {
           const scale = (2 * camera.radius * camera.zoom) / canvas.clientHeight;
           const right = [Math.cos(camera.yaw), 0, -Math.sin(camera.yaw)];
           camera.target = camera.target.map((t, c) => t - dx * scale * right[c] + (c === 1 ? dy * scale : 0));
@@ -939,6 +1017,7 @@
       }
       const j = jointAt(event.clientX, event.clientY);
       tip.hidden = j < 0;
+      canvas.style.cursor = j >= 0 && state.skeleton ? 'crosshair' : '';
       if (j >= 0) {
         tip.textContent = jointNames[j];
         tip.style.left = `${event.clientX + 12}px`;
@@ -967,9 +1046,16 @@
     // Start on the skeleton's root (the first joint whose parent is not a joint).
     selectJoint(Math.max(0, mainSkin.joints.findIndex((n) => !mainSkin.joints.includes(scene.nodes[n].parent))));
 
-    // Test hook: joints with the number of vertices they dominate, a grey-level thumbnail
-    // (160 x 120 samples) of a freshly rendered frame, and the WebGL error flag.
-    hook.joints = () => jointNames.map((name, index) => ({ name, index, vertices: dominantCount[index] }));
+    // Test hook: joints with the number of vertices they dominate and their parent joint (-1
+    // for a root), a grey-level thumbnail (160 x 120 samples) of a freshly rendered frame, the
+    // WebGL error flag, the camera, and the user rotation of joint j (the slider angles in
+    // degrees and the quaternion (x, y, z, w) they make).
+    hook.joints = () => jointNames.map((name, index) => ({ name, index, vertices: dominantCount[index], parent: parentJoint[index] }));
+    hook.camera = () => ({ ...camera, target: [...camera.target] });
+    hook.jointRotation = (j) => {
+      const degrees = [...scene.nodes[mainSkin.joints[j]].user];
+      return { degrees, quaternion: quat.fromEulerDegrees(degrees) };
+    };
     hook.glError = () => gl.getError();
     hook.projectJoint = projectJoint;
     hook.curveSegments = curves.count / 2;
@@ -1042,6 +1128,8 @@
       return out;
     };
     hook.state = state;
+    // A first frame before `ready`, so that projectJoint sees the camera.
+    render();
     hook.ready = true;
   }
 
