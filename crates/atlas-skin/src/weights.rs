@@ -446,7 +446,7 @@ struct SoftSide {
     half_width: f64,
     /// Bit v set when vertex v is on the child side reached along the surface.
     reached: Vec<u64>,
-    /// (κ_c, beyond_c) of every reached vertex, by increasing vertex.
+    /// (κ_c, π_c) of every reached vertex, by increasing vertex.
     ownership: Vec<(u32, f64, f64)>,
 }
 
@@ -495,6 +495,8 @@ fn soft_sides(
     let positions = &d.surface.positions;
     let vertex_count = d.surface.vertex_count();
     let segments = bone_segments(skeleton);
+    // Joints with a boundary of their own (a cut, or a soft boundary with a section): π_c
+    // leaves their bones, and the bones below them, to them.
     let mut handled = vec![false; skeleton.len()];
     for b in &d.boundaries {
         if b.kind != BoundaryKind::Soft || b.diameter > 0.0 {
@@ -620,7 +622,7 @@ fn region_trees(
                         None => break 0,
                         Some(a) => match tree.joints.iter().position(|&j| j as usize == a) {
                             Some(p) => break p,
-                            _ => ancestor = skeleton.parent(a),
+                            None => ancestor = skeleton.parent(a),
                         },
                     }
                 };
