@@ -23,7 +23,9 @@ use atlas_skin_io::load_character;
 use atlas_skin_runtime::Skeleton;
 use decompose_checks::check_decomposition;
 
-fn load(model: &Model) -> (SurfaceMesh, Skeleton) {
+/// The model's welded mesh and skeleton, and their decomposition with the default
+/// parameters.
+fn decomposed(model: &Model) -> (SurfaceMesh, Skeleton, Decomposition) {
     let character = load_character(&model.input_path(), &model.load_options(false))
         .unwrap_or_else(|e| panic!("{}: {e}", model.name));
     let welded = weld(
@@ -32,7 +34,14 @@ fn load(model: &Model) -> (SurfaceMesh, Skeleton) {
         DEFAULT_WELD_TOLERANCE,
     );
     let skeleton = character.skeleton.expect("the model has a skeleton");
-    (welded.mesh, skeleton)
+    let d = decompose(
+        &welded.mesh,
+        &Topology::new(&welded.mesh),
+        &skeleton,
+        &DecomposeParams::default(),
+    )
+    .expect("decomposes");
+    (welded.mesh, skeleton, d)
 }
 
 /// Reasons for which a joint inside the mesh may have no boundary: it owns no geometry.
@@ -45,14 +54,7 @@ const NO_GEOMETRY: [&str; 3] = [
 /// Decomposes a closed genus-0 model, checks the invariants and that `required` joints
 /// are cut; prints the report's summary.
 fn check_closed_model(model: &Model, required: &[&str]) -> Decomposition {
-    let (mesh, skeleton) = load(model);
-    let d = decompose(
-        &mesh,
-        &Topology::new(&mesh),
-        &skeleton,
-        &DecomposeParams::default(),
-    )
-    .expect("decomposes");
+    let (mesh, skeleton, d) = decomposed(model);
     let cuts = check_decomposition(&d, true);
     let positions = skeleton.bind_positions();
     for (j, decision) in d.joints.iter().enumerate() {
@@ -192,15 +194,7 @@ fn makehuman_body_cuts_every_limb_joint() {
 
 #[test]
 fn simpleskin_open_strip_finishes_with_reasons() {
-    let model = SIMPLESKIN;
-    let (mesh, skeleton) = load(&model);
-    let d = decompose(
-        &mesh,
-        &Topology::new(&mesh),
-        &skeleton,
-        &DecomposeParams::default(),
-    )
-    .expect("decomposes");
+    let (_, _, d) = decomposed(&SIMPLESKIN);
     check_decomposition(&d, false);
     assert_eq!(d.joints.len(), 2);
     assert!(d

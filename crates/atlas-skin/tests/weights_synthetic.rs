@@ -226,16 +226,19 @@ fn mitre(points: &[DVec3], k: usize) -> DVec3 {
     ((points[k] - points[k - 1]).normalize() + (points[k + 1] - points[k]).normalize()).normalize()
 }
 
+/// The cut at joint `k` of a chain through `points`, on its mitre plane.
+fn mitre_cut(points: &[DVec3], k: usize) -> Plane {
+    Plane {
+        joint: k as u32,
+        point: points[k],
+        normal: mitre(points, k),
+    }
+}
+
 #[test]
 fn arm_joints_carry_no_weight_on_the_thigh_the_hand_touches() {
     let (mesh, skeleton, points) = hand_touching_thigh();
-    let cuts: Vec<Plane> = (1..=3)
-        .map(|k| Plane {
-            joint: k as u32,
-            point: points[k],
-            normal: mitre(&points, k),
-        })
-        .collect();
+    let cuts: Vec<Plane> = (1..=3).map(|k| mitre_cut(&points, k)).collect();
     // The wrist's soft plane (normal −x at x = 4) has the whole thigh on its child side in
     // space.
     let softs = [(
@@ -270,11 +273,7 @@ fn arm_joints_carry_no_weight_on_the_thigh_the_hand_touches() {
 /// near the hip, far from the wrist along the surface).
 fn one_arm_region(soft_joints: &[usize]) -> (SurfaceMesh, Skeleton, Decomposition) {
     let (mesh, skeleton, points) = hand_touching_thigh();
-    let cuts = [Plane {
-        joint: 1,
-        point: points[1],
-        normal: mitre(&points, 1),
-    }];
+    let cuts = [mitre_cut(&points, 1)];
     let softs: Vec<(Plane, f64)> = soft_joints
         .iter()
         .map(|&k| {
@@ -523,13 +522,7 @@ fn vertices_no_region_with_joints_reaches_take_the_nearest_weights() {
     );
     mesh.triangles
         .extend([[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]].map(|t| t.map(|v| base + v)));
-    let cuts: Vec<Plane> = (1..=3)
-        .map(|k| Plane {
-            joint: k as u32,
-            point: points[k],
-            normal: mitre(&points, k),
-        })
-        .collect();
+    let cuts: Vec<Plane> = (1..=3).map(|k| mitre_cut(&points, k)).collect();
     let mut decomposition = decompose_by_hand(&mesh, &skeleton, &cuts, &[], 1.0, SIDES);
     // Take the joints from the tetrahedron's region and from the top bar's (the hip's).
     let region_of = |v: u32| {
