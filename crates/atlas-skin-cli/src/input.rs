@@ -1,7 +1,8 @@
 //! Input options shared by the subcommands that read a character.
 
 use anyhow::{Context, Result};
-use atlas_skin::{weld, MeshStats, Topology, Welded};
+use atlas_skin::pipeline::{skin, SkinInput, SkinParams, WeldedSurface};
+use atlas_skin::{MeshStats, Topology, Welded};
 use atlas_skin_io::{Character, LoadOptions, TriangleMesh};
 use std::path::PathBuf;
 
@@ -71,18 +72,14 @@ pub fn skin_character(character: &mut Character) -> Result<()> {
         .skeleton
         .as_ref()
         .with_context(|| format!("{} has no skeleton", character.path.display()))?;
-    let welded = weld(
-        &character.mesh.positions,
-        &character.mesh.triangles,
-        atlas_skin::weld::DEFAULT_WELD_TOLERANCE,
-    );
-    let topology = Topology::new(&welded.mesh);
-    let skinned = atlas_skin::pipeline::skin(
-        &welded,
-        &topology,
-        &character.mesh.positions,
-        skeleton,
-        &atlas_skin::pipeline::SkinParams::default(),
+    let skinned = skin(
+        SkinInput {
+            positions: &character.mesh.positions,
+            triangles: &character.mesh.triangles,
+            skeleton,
+            end_joints: &character.end_joints,
+        },
+        &SkinParams::default(),
         &mut |_| {},
     )
     .with_context(|| format!("cannot skin {}", character.path.display()))?;
@@ -93,7 +90,7 @@ pub fn skin_character(character: &mut Character) -> Result<()> {
 /// The built-in demo character ([`atlas_skin::demo`]) as if read from a file named
 /// `demo`: mesh and skeleton, no weights.
 pub fn demo_character() -> Character {
-    let demo = atlas_skin::demo::demo_character(atlas_skin::demo::DEFAULT_STEP);
+    let demo = atlas_skin::fixtures::demo::demo_character(atlas_skin::fixtures::demo::DEFAULT_STEP);
     let mut character = Character::new(
         "demo",
         TriangleMesh {
@@ -115,12 +112,8 @@ pub struct Prepared {
 
 impl Prepared {
     pub fn new(character: Character) -> Self {
-        let welded = weld(
-            &character.mesh.positions,
-            &character.mesh.triangles,
-            atlas_skin::weld::DEFAULT_WELD_TOLERANCE,
-        );
-        let topology = Topology::new(&welded.mesh);
+        let WeldedSurface { welded, topology } =
+            WeldedSurface::new(&character.mesh.positions, &character.mesh.triangles);
         let stats = MeshStats::new(&welded.mesh, &topology);
         Self {
             character,

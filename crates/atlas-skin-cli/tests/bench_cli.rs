@@ -1,7 +1,7 @@
 //! `atlas-skin bench` and `atlas-skin pose` without INPUT: both run on the built-in demo
 //! character skinned by the method.
 
-use atlas_skin::demo::{demo_character, DEFAULT_STEP};
+use atlas_skin::fixtures::demo::{demo_character, DEFAULT_STEP};
 use serde_json::Value;
 
 mod support;

@@ -91,7 +91,7 @@ fn skin_runs_on_every_corpus_model_and_writes_valid_bound_skins() {
             "weld",
             "topology",
             "decompose",
-            "distances",
+            "overlap",
             "weights",
             "write",
         ] {
@@ -144,7 +144,7 @@ fn options_reach_the_method_and_bad_ones_are_refused() {
     let model = &RIGGEDFIGURE;
     let glb = dir.join("figure.glb");
     let config = dir.join("config.json");
-    std::fs::write(&config, r#"{"weights": {"overlap": {"factor": 0.6}}}"#).expect("config");
+    std::fs::write(&config, r#"{"overlap": {"factor": 0.6}}"#).expect("config");
     let args = [
         "-o",
         glb.to_str().expect("utf-8 path"),

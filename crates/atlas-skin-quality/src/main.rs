@@ -6,8 +6,8 @@ mod baselines;
 mod table;
 
 use anyhow::{bail, Context, Result};
-use atlas_skin::eval::Evaluation;
 use atlas_skin_corpus::{Model, Reference, MODELS};
+use atlas_skin_eval::Evaluation;
 use clap::Parser;
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};

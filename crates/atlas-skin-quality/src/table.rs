@@ -1,8 +1,8 @@
 //! docs/quality.md: our figures beside the baseline rows, and the headline counts.
 
 use crate::baselines::BaselineRow;
-use atlas_skin::eval::{DeformError, Evaluation};
 use atlas_skin_corpus::{Model, Reference};
+use atlas_skin_eval::{DeformError, Evaluation};
 use std::fmt::Write;
 
 /// The tool every figure is held to (issue 5's goal).
@@ -246,8 +246,8 @@ fn seconds(s: Option<f64>) -> String {
 mod tests {
     use super::*;
     use crate::baselines::parse_baselines;
-    use atlas_skin::eval::{Bleeding, Validity, WeightsL1};
     use atlas_skin_corpus::MODELS;
+    use atlas_skin_eval::{Bleeding, Validity, WeightsL1};
 
     fn evaluation(mean: f64, max: f64, bleed: f64) -> Evaluation {
         Evaluation {

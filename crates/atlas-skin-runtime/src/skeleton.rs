@@ -155,6 +155,12 @@ impl Skeleton {
         (p != NO_PARENT).then_some(p as usize)
     }
 
+    /// The joints above `j`, nearest first: its parent, its grandparent, ... up to its
+    /// root (a valid skeleton has no cycles).
+    pub fn ancestors(&self, j: usize) -> impl Iterator<Item = usize> + '_ {
+        std::iter::successors(self.parent(j), move |&a| self.parent(a))
+    }
+
     /// Children of every joint, in index order.
     pub fn children(&self) -> Vec<Vec<usize>> {
         let mut children = vec![Vec::new(); self.len()];

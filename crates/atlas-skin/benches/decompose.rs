@@ -3,8 +3,8 @@
 //! `cargo bench -p atlas-skin --bench decompose`. Target: makehuman's body (26 756
 //! triangles, 163 joints) under 100 ms in release on 2 cores.
 
-use atlas_skin::shapes::capsule_chain;
-use atlas_skin::weld::DEFAULT_WELD_TOLERANCE;
+use atlas_skin::fixtures::shapes::capsule_chain;
+use atlas_skin::mesh::weld::DEFAULT_WELD_TOLERANCE;
 use atlas_skin::{decompose, weld, DecomposeParams, SurfaceMesh, Topology};
 use atlas_skin_corpus::MAKEHUMAN;
 use atlas_skin_io::load_character;

@@ -4,8 +4,8 @@
 //! vertices, distances from one vertex over the whole sphere and within a band of 0.3
 //! (about a tenth of the half circumference, the size of an overlap band).
 
-use atlas_skin::geodesic::{march_distances, MarchScratch};
-use atlas_skin::shapes::icosphere;
+use atlas_skin::fixtures::shapes::icosphere;
+use atlas_skin::overlap::geodesic::{march_distances, MarchScratch};
 use atlas_skin::Topology;
 use divan::Bencher;
 

@@ -1,19 +1,16 @@
-//! Speed of the whole method after parsing and welding: decomposition, distances, weights
-//! and weights per stored vertex ([`atlas_skin::pipeline::skin`]).
+//! Speed of the whole method after parsing ([`atlas_skin::pipeline::skin`]): welding,
+//! topology, decomposition, overlaps, weights and weights per stored vertex.
 //!
 //! `cargo bench -p atlas-skin --bench pipeline`. Targets (release, 2 cores): cesiumman
 //! ≤ 5 ms, makehuman's body ≤ 60 ms, a character of over a million triangles (makehuman's
 //! body subdivided three times: 1.7M triangles) under 15 s and 4 GB; the peak resident
 //! memory of the process is printed at the end.
 
-use atlas_skin::pipeline::{skin, SkinParams};
-use atlas_skin::weld::DEFAULT_WELD_TOLERANCE;
-use atlas_skin::{weld, Topology, Welded};
+use atlas_skin::pipeline::{skin, SkinInput, SkinParams};
 use atlas_skin_corpus::{Model, CESIUMMAN, MAKEHUMAN};
 use atlas_skin_io::{load_character, Character, TriangleMesh};
 use atlas_skin_runtime::Skeleton;
 use divan::Bencher;
-use glam::Vec3;
 use std::collections::HashMap;
 
 fn main() {
@@ -63,56 +60,35 @@ fn subdivide(mesh: &TriangleMesh, levels: usize) -> TriangleMesh {
     out
 }
 
-struct Prepared {
-    positions: Vec<Vec3>,
-    welded: Welded,
-    topology: Topology,
-    skeleton: Skeleton,
-}
-
-fn prepare(mesh: &TriangleMesh, skeleton: Option<Skeleton>) -> Prepared {
-    let welded = weld(&mesh.positions, &mesh.triangles, DEFAULT_WELD_TOLERANCE);
-    let topology = Topology::new(&welded.mesh);
-    Prepared {
-        positions: mesh.positions.clone(),
-        welded,
-        topology,
-        skeleton: skeleton.expect("the model has a skeleton"),
-    }
-}
-
-fn bench_skin(bencher: Bencher, prepared: &Prepared) {
+fn bench_skin(bencher: Bencher, mesh: &TriangleMesh, skeleton: Option<Skeleton>) {
+    let skeleton = skeleton.expect("the model has a skeleton");
     let params = SkinParams::default();
+    let input = SkinInput {
+        positions: &mesh.positions,
+        triangles: &mesh.triangles,
+        skeleton: &skeleton,
+        end_joints: &[],
+    };
     bencher
-        .counter(prepared.welded.mesh.triangle_count())
-        .bench(|| {
-            skin(
-                &prepared.welded,
-                &prepared.topology,
-                &prepared.positions,
-                &prepared.skeleton,
-                &params,
-                &mut |_| {},
-            )
-            .expect("skins")
-        });
+        .counter(mesh.triangles.len())
+        .bench(|| skin(input, &params, &mut |_| {}).expect("skins"));
 }
 
 #[divan::bench(sample_count = 20)]
 fn cesiumman(bencher: Bencher) {
     let character = load(&CESIUMMAN);
-    bench_skin(bencher, &prepare(&character.mesh, character.skeleton));
+    bench_skin(bencher, &character.mesh, character.skeleton);
 }
 
 #[divan::bench(sample_count = 20)]
 fn makehuman_body(bencher: Bencher) {
     let character = load(&MAKEHUMAN);
-    bench_skin(bencher, &prepare(&character.mesh, character.skeleton));
+    bench_skin(bencher, &character.mesh, character.skeleton);
 }
 
 #[divan::bench(sample_count = 2, sample_size = 1)]
 fn makehuman_body_subdivided_1m(bencher: Bencher) {
     let character = load(&MAKEHUMAN);
     let mesh = subdivide(&character.mesh, 3);
-    bench_skin(bencher, &prepare(&mesh, character.skeleton));
+    bench_skin(bencher, &mesh, character.skeleton);
 }

@@ -1,7 +1,7 @@
 //! The result of the decomposition stages (§3.1 cuts, §3.2 regions): what the weights stage
 //! (§3.3–§5) reads. Plain data; [`crate::decompose()`] builds it.
 
-use crate::{SurfaceMesh, Topology};
+use crate::mesh::{SurfaceMesh, Topology};
 use glam::DVec3;
 use serde::Serialize;
 

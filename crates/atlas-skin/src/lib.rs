@@ -1,39 +1,37 @@
 //! Atlas-based character skinning with automatic mesh decomposition
 //! (Lu, Hétroy, Gérot, Thibert, INRIA RR-6406, 2008).
 //!
-//! The pipeline, one module per stage:
-//! mesh analysis ([`weld`](mod@weld), [`topology`], [`winding`]) → cuts at joints (§3.1) →
-//! regions (§3.2) → surface distances and overlaps (§3.3) → weights (§4, §5).
+//! The pipeline ([`pipeline::skin`]), one folder per stage, in order:
+//!
+//! | stage | paper | module |
+//! | --- | --- | --- |
+//! | the surface: welding, topology, spatial index, winding number | | [`mesh`] |
+//! | bones as segments, nearest bones | | [`skeleton`] |
+//! | boundaries at the joints: joint roles, plane search, plane sections, conflicts, split | §3.1 | [`cuts`] |
+//! | regions of the split surface, the joints bound to them | §3.2 | [`regions`] |
+//! | the decomposition driver (§3.1 then §3.2) and its result | §3.1–3.2 | [`decompose()`], [`decomposition`] |
+//! | overlaps: surface distances from each cut, widths | §3.3 | [`overlap`] |
+//! | weights: blending, chains, soft boundaries, patches | §4, §5 | [`weights`] |
+//! | what the report shows of a decomposition | | [`report`] |
+//! | shapes with known answers and the demo character | | [`fixtures`] |
 
-pub mod blend;
-pub mod cut;
+pub mod cuts;
 pub mod decompose;
 pub mod decomposition;
-pub mod decomposition_report;
-pub mod demo;
-pub mod eval;
-pub mod geodesic;
-pub mod joint_roles;
+pub mod fixtures;
+pub mod geometry;
 pub mod mesh;
-pub mod nearest_bone;
 pub mod overlap;
-pub mod ownership;
-pub mod patches;
 pub mod pipeline;
-pub mod plane_section;
-pub mod proximity;
-pub mod segment;
-pub mod shapes;
-pub mod split;
-pub mod topology;
+pub mod regions;
+pub mod report;
+pub mod rows;
+pub mod skeleton;
 pub mod weights;
-pub mod weld;
-pub mod winding;
 
 pub use decompose::{decompose, DecomposeError, DecomposeParams};
 pub use decomposition::{
     Boundary, BoundaryKind, Decomposition, JointDecision, JointStatus, Region,
 };
-pub use mesh::SurfaceMesh;
-pub use topology::{MeshStats, Topology};
-pub use weld::{weld, Welded};
+pub use mesh::{weld, MeshStats, SurfaceMesh, Topology, Welded};
+pub use pipeline::{skin, SkinError, SkinInput, SkinParams, Skinned};

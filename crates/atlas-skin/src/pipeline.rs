@@ -1,15 +1,23 @@
-//! The whole method after welding: decomposition (§3.1–3.2) → surface distances and
-//! overlaps (§3.3) → weights (§4, §5) → weights per stored vertex, with per-stage timings
-//! and counts for the report.
+//! The whole method, from the mesh as stored to weights per stored vertex:
+//! weld ([`crate::mesh::weld()`]) → topology → decomposition (§3.1 cuts, §3.2 regions:
+//! [`crate::decompose()`]) → overlaps (§3.3: [`crate::overlap`]) → weights (§4, §5:
+//! [`crate::weights`]) → un-weld (weights per stored vertex, pruned to `max_influences`).
+//! Settings are validated once, before any work; each stage's wall time is measured here.
+//!
+//! Inputs: a [`SkinInput`] (stored positions and triangles, the skeleton in the mesh's bind
+//! space, the joints the input marks as end points) and [`SkinParams`]. Output: [`Skinned`].
 
 use crate::decompose::{decompose, DecomposeError, DecomposeParams};
-use crate::overlap::{compute_overlaps, Overlaps};
-use crate::weights::{
-    compute_weights, stored_weights, SurfaceWeights, WeightCounts, WeightParams, WeightsError,
-};
-use crate::{Decomposition, Topology, Welded};
-use atlas_skin_runtime::{Skeleton, VertexWeights};
+use crate::decomposition::Decomposition;
+use crate::mesh::weld::DEFAULT_WELD_TOLERANCE;
+use crate::mesh::{weld, Topology, Welded};
+use crate::overlap::{compute_overlaps, OverlapError, OverlapParams, Overlaps};
+use crate::skeleton::bones::{bone_segments, nearest_bone};
+use crate::weights::blend::Blend;
+use crate::weights::{compute_weights, SurfaceWeights, WeightCounts, WeightsError};
+use atlas_skin_runtime::{RuntimeError, Skeleton, VertexWeights};
 use glam::Vec3;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 use thiserror::Error;
@@ -18,20 +26,41 @@ use thiserror::Error;
 /// the message, so that chain printers show it once).
 #[derive(Debug, Error)]
 pub enum SkinError {
+    #[error("invalid settings")]
+    Settings(#[from] SettingsError),
     #[error("decomposition failed")]
     Decompose(#[from] DecomposeError),
+    #[error("overlaps failed")]
+    Overlap(#[from] OverlapError),
     #[error("weights failed")]
     Weights(#[from] WeightsError),
 }
 
-/// Every setting of the method; a config file may carry any subset (serde, unknown fields
-/// rejected).
+/// What is wrong with [`SkinParams`] or with the input as the pipeline receives it.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum SettingsError {
+    #[error("--max-influences must be at least 1")]
+    NoInfluences,
+    #[error("{found} stored positions, but the triangles use vertex {vertex}")]
+    TriangleVertexOutOfRange { vertex: u32, found: usize },
+    #[error("end joint {joint} is not in the skeleton of {count} joints")]
+    EndJointOutOfRange { joint: u32, count: usize },
+    #[error("invalid skeleton: {0}")]
+    Skeleton(#[from] RuntimeError),
+}
+
+/// Every setting of the method, one field per stage; a config file may carry any subset
+/// (serde, unknown fields rejected).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SkinParams {
+    /// §3.1–3.2: plane search, joint roles, forced and forbidden joints.
     pub decompose: DecomposeParams,
-    pub weights: WeightParams,
-    /// Influences kept per vertex, the largest, renormalised (at least 1).
+    /// §3.3: overlap widths.
+    pub overlap: OverlapParams,
+    /// §4: how overlapping regions are blended.
+    pub blend: Blend,
+    /// Influences kept per stored vertex, the largest, renormalised (at least 1).
     pub max_influences: usize,
 }
 
@@ -39,17 +68,34 @@ impl Default for SkinParams {
     fn default() -> Self {
         Self {
             decompose: DecomposeParams::default(),
-            weights: WeightParams::default(),
+            overlap: OverlapParams::default(),
+            blend: Blend::default(),
             max_influences: 4,
         }
     }
 }
 
+/// A character as the method reads it.
+#[derive(Debug, Clone, Copy)]
+pub struct SkinInput<'a> {
+    /// #stored vertex positions, as the file stores them (seams split, duplicates kept).
+    pub positions: &'a [Vec3],
+    /// #F triangles indexing `positions`.
+    pub triangles: &'a [[u32; 3]],
+    /// The skeleton in the mesh's bind space.
+    pub skeleton: &'a Skeleton,
+    /// Joints the input marks as end points that move nothing (the leaves of a TGF
+    /// skeleton, libigl's handles): forbidden a boundary unless the settings force them.
+    pub end_joints: &'a [u32],
+}
+
 /// The stages [`skin`] reports to its progress callback as it starts them.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Stage {
+    Weld,
+    Topology,
     Decompose,
-    Distances,
+    Overlap,
     Weights,
 }
 
@@ -57,20 +103,18 @@ impl Stage {
     /// Name of the stage, as in the report's `timings_ms`.
     pub fn name(self) -> &'static str {
         match self {
+            Stage::Weld => "weld",
+            Stage::Topology => "topology",
             Stage::Decompose => "decompose",
-            Stage::Distances => "distances",
+            Stage::Overlap => "overlap",
             Stage::Weights => "weights",
         }
     }
 }
 
-/// Wall time of each stage, in milliseconds.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
-pub struct StageTimings {
-    pub decompose: f64,
-    pub distances: f64,
-    pub weights: f64,
-}
+/// Wall time of each stage, in milliseconds, in pipeline order.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct StageTimings(pub Vec<(Stage, f64)>);
 
 /// Sizes and fallbacks, for the report.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
@@ -91,6 +135,8 @@ pub struct SkinCounts {
 /// Everything [`skin`] computed.
 #[derive(Debug, Clone)]
 pub struct Skinned {
+    /// #stored: the welded vertex of every stored vertex ([`Welded::welded_of_stored`]).
+    pub welded_of_stored: Vec<u32>,
     pub decomposition: Decomposition,
     pub overlaps: Overlaps,
     /// Weights of every split-surface vertex, before pruning.
@@ -101,60 +147,81 @@ pub struct Skinned {
     pub counts: SkinCounts,
 }
 
-/// Skins a welded character.
+/// A welded surface with its topology: what every analysis of the mesh starts from.
+#[derive(Debug, Clone)]
+pub struct WeldedSurface {
+    pub welded: Welded,
+    pub topology: Topology,
+}
+
+impl WeldedSurface {
+    /// Welds coincident vertices of the stored mesh (within [`DEFAULT_WELD_TOLERANCE`] of
+    /// its diagonal) and builds the topology of the result.
+    pub fn new(positions: &[Vec3], triangles: &[[u32; 3]]) -> Self {
+        let welded = weld(positions, triangles, DEFAULT_WELD_TOLERANCE);
+        let topology = Topology::new(&welded.mesh);
+        Self { welded, topology }
+    }
+}
+
+/// Skins a character: the stages of the module documentation.
 ///
-/// - `welded`, `topology`: the welded input mesh ([`crate::weld()`]) and its topology.
-/// - `stored_positions`: the input mesh's vertices as stored (#stored, as `welded` maps).
-/// - `skeleton`: in the mesh's bind space.
-/// - `progress`: called with each stage as it starts.
+/// - `progress`: called with each stage as it starts (not at all when the settings or the
+///   input are refused).
 pub fn skin(
-    welded: &Welded,
-    topology: &Topology,
-    stored_positions: &[Vec3],
-    skeleton: &Skeleton,
+    input: SkinInput,
     params: &SkinParams,
     progress: &mut dyn FnMut(Stage),
 ) -> Result<Skinned, SkinError> {
-    if params.max_influences == 0 {
-        return Err(WeightsError::NoInfluences.into());
-    }
-    params.weights.overlap.validate(skeleton)?;
+    let params = validate(input, params)?;
     let mut timings = StageTimings::default();
+    let mut run = |stage: Stage| {
+        progress(stage);
+        let start = Instant::now();
+        move |timings: &mut StageTimings| timings.0.push((stage, elapsed_ms(start)))
+    };
 
-    progress(Stage::Decompose);
-    let start = Instant::now();
-    let decomposition = decompose(&welded.mesh, topology, skeleton, &params.decompose)?;
-    timings.decompose = elapsed_ms(start);
+    let done = run(Stage::Weld);
+    let welded = weld(input.positions, input.triangles, DEFAULT_WELD_TOLERANCE);
+    done(&mut timings);
 
-    progress(Stage::Distances);
-    let start = Instant::now();
-    let overlaps = compute_overlaps(&decomposition, skeleton, &params.weights.overlap)?;
-    timings.distances = elapsed_ms(start);
+    let done = run(Stage::Topology);
+    let topology = Topology::new(&welded.mesh);
+    done(&mut timings);
 
-    progress(Stage::Weights);
-    let start = Instant::now();
+    let done = run(Stage::Decompose);
+    let decomposition = decompose(&welded.mesh, &topology, input.skeleton, &params.decompose)?;
+    done(&mut timings);
+
+    let done = run(Stage::Overlap);
+    let overlaps = compute_overlaps(&decomposition, input.skeleton, &params.overlap)?;
+    done(&mut timings);
+
+    let done = run(Stage::Weights);
     let (surface_weights, weight_counts) =
-        compute_weights(&decomposition, skeleton, &overlaps, params.weights.blend)?;
-    let weights = stored_weights(
+        compute_weights(&decomposition, input.skeleton, &overlaps, params.blend)?;
+    let weights = unweld_weights(
         &surface_weights,
         &welded.welded_of_stored,
-        stored_positions,
-        skeleton,
+        input.positions,
+        input.skeleton,
         params.max_influences,
-    )?;
-    timings.weights = elapsed_ms(start);
+    );
+    done(&mut timings);
 
     let counts = SkinCounts {
-        stored_vertices: stored_positions.len(),
+        stored_vertices: input.positions.len(),
         welded_vertices: welded.mesh.vertex_count(),
         surface_vertices: decomposition.surface.vertex_count(),
-        joints: skeleton.len(),
+        joints: input.skeleton.len(),
         weights: weight_counts,
-        unreferenced_stored_vertices: stored_positions
+        unreferenced_stored_vertices: input
+            .positions
             .len()
             .saturating_sub(welded.referenced_stored),
     };
     Ok(Skinned {
+        welded_of_stored: welded.welded_of_stored,
         decomposition,
         overlaps,
         surface_weights,
@@ -162,6 +229,85 @@ pub fn skin(
         timings,
         counts,
     })
+}
+
+/// Checks the settings and the input once, and returns the settings the stages run with:
+/// `params` with the input's end joints forbidden unless forced.
+fn validate(input: SkinInput, params: &SkinParams) -> Result<SkinParams, SkinError> {
+    if params.max_influences == 0 {
+        return Err(SettingsError::NoInfluences.into());
+    }
+    input.skeleton.validate().map_err(SettingsError::from)?;
+    let found = input.positions.len();
+    if let Some(&vertex) = input
+        .triangles
+        .iter()
+        .flatten()
+        .find(|&&v| v as usize >= found)
+    {
+        return Err(SettingsError::TriangleVertexOutOfRange { vertex, found }.into());
+    }
+    params.decompose.validate()?;
+    params.overlap.validate(input.skeleton)?;
+    let mut params = params.clone();
+    for &j in input.end_joints {
+        let name =
+            input
+                .skeleton
+                .names
+                .get(j as usize)
+                .ok_or(SettingsError::EndJointOutOfRange {
+                    joint: j,
+                    count: input.skeleton.len(),
+                })?;
+        let decompose = &mut params.decompose;
+        if !decompose.force.contains(name) && !decompose.forbid.contains(name) {
+            decompose.forbid.push(name.clone());
+        }
+    }
+    Ok(params)
+}
+
+/// Weights per stored vertex of the input mesh: surface vertex `welded_of_stored[s]` for
+/// stored vertex s (the split surface starts with the welded vertices), keeping the
+/// `max_influences` (≥ 1) largest weights and rescaling them to sum to 1. A stored vertex
+/// no triangle uses ([`crate::mesh::weld::UNREFERENCED`]) is bound to its nearest bone.
+///
+/// - `surface_weights`: from [`compute_weights`].
+/// - `welded_of_stored`, `stored_positions`: #stored entries each ([`Welded`] and the input
+///   mesh).
+pub fn unweld_weights(
+    surface_weights: &SurfaceWeights,
+    welded_of_stored: &[u32],
+    stored_positions: &[Vec3],
+    skeleton: &Skeleton,
+    max_influences: usize,
+) -> VertexWeights {
+    debug_assert!(max_influences >= 1);
+    debug_assert_eq!(stored_positions.len(), welded_of_stored.len());
+    let segments = bone_segments(skeleton);
+    let rows: Vec<Vec<(u32, f32)>> = welded_of_stored
+        .par_iter()
+        .zip(stored_positions)
+        .map(|(&w, &p)| {
+            let mut row: Vec<(u32, f64)> = if (w as usize) < surface_weights.vertex_count() {
+                surface_weights.row(w as usize).collect()
+            } else {
+                nearest_bone(&segments, p.as_dvec3())
+                    .map(|j| (j, 1.0))
+                    .into_iter()
+                    .collect()
+            };
+            row.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+            row.truncate(max_influences);
+            let total: f64 = row.iter().map(|&(_, x)| x).sum();
+            row.into_iter()
+                .filter(|_| total > 0.0)
+                .map(|(j, x)| (j, (x / total) as f32))
+                .collect()
+        })
+        .collect();
+    VertexWeights::from_rows(rows)
 }
 
 fn elapsed_ms(start: Instant) -> f64 {

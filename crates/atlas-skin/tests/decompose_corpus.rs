@@ -11,8 +11,8 @@
 
 mod decompose_checks;
 
-use atlas_skin::weld::DEFAULT_WELD_TOLERANCE;
-use atlas_skin::winding::winding_number;
+use atlas_skin::mesh::weld::DEFAULT_WELD_TOLERANCE;
+use atlas_skin::mesh::winding::winding_number;
 use atlas_skin::{
     decompose, weld, DecomposeParams, Decomposition, JointStatus, SurfaceMesh, Topology,
 };

@@ -4,8 +4,8 @@
 
 mod decompose_checks;
 
-use atlas_skin::demo::{demo_character, expected_cut_joints, DEFAULT_STEP};
-use atlas_skin::weld::DEFAULT_WELD_TOLERANCE;
+use atlas_skin::fixtures::demo::{demo_character, expected_cut_joints, DEFAULT_STEP};
+use atlas_skin::mesh::weld::DEFAULT_WELD_TOLERANCE;
 use atlas_skin::{decompose, weld, DecomposeParams, JointStatus, Topology};
 use decompose_checks::check_decomposition;
 

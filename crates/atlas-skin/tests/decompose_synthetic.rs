@@ -2,8 +2,8 @@
 
 mod decompose_checks;
 
-use atlas_skin::decomposition_report::{debug_colors, debug_lines};
-use atlas_skin::shapes::{bent_cylinder, capsule_chain, uv_sphere};
+use atlas_skin::fixtures::shapes::{bent_cylinder, capsule_chain, uv_sphere};
+use atlas_skin::report::{debug_colors, debug_lines};
 use atlas_skin::{
     decompose, BoundaryKind, DecomposeError, DecomposeParams, Decomposition, JointStatus,
     SurfaceMesh, Topology,

@@ -1,8 +1,8 @@
 //! Fast-marching distances against exact answers: great-circle distances on refined
 //! icospheres, straight-line distances on a flat grid.
 
-use atlas_skin::geodesic::{march_distances, MarchScratch};
-use atlas_skin::shapes::icosphere;
+use atlas_skin::fixtures::shapes::icosphere;
+use atlas_skin::overlap::geodesic::{march_distances, MarchScratch};
 use atlas_skin::{SurfaceMesh, Topology};
 use glam::DVec3;
 

@@ -1,31 +1,48 @@
-//! The whole method after welding ([`atlas_skin::pipeline::skin`]) on a bent tube: stages in
-//! order, weights for every stored vertex, a smooth transition at the joint, settings
-//! checked before any work.
+//! The whole method ([`atlas_skin::pipeline::skin`]) on a bent tube: stages in order,
+//! weights for every stored vertex, a smooth transition at the joint, settings checked
+//! before any work.
 
-use atlas_skin::pipeline::{skin, SkinError, SkinParams, Stage};
-use atlas_skin::shapes::bent_cylinder;
-use atlas_skin::weights::WeightsError;
-use atlas_skin::weld::DEFAULT_WELD_TOLERANCE;
-use atlas_skin::{weld, Topology};
+use atlas_skin::fixtures::shapes::bent_cylinder;
+use atlas_skin::overlap::OverlapError;
+use atlas_skin::pipeline::{skin, SettingsError, SkinError, SkinInput, SkinParams, Stage};
+use atlas_skin::DecomposeError;
+use atlas_skin_runtime::Skeleton;
 use glam::Vec3;
+
+fn input<'a>(
+    positions: &'a [Vec3],
+    triangles: &'a [[u32; 3]],
+    skeleton: &'a Skeleton,
+) -> SkinInput<'a> {
+    SkinInput {
+        positions,
+        triangles,
+        skeleton,
+        end_joints: &[],
+    }
+}
 
 #[test]
 fn a_bent_tube_is_skinned_with_a_smooth_transition_at_its_joint() {
     let (mesh, skeleton) = bent_cylinder(0.5, 4.0, 60.0, 24, 16);
     let positions: Vec<Vec3> = mesh.positions.iter().map(|p| p.as_vec3()).collect();
-    let welded = weld(&positions, &mesh.triangles, DEFAULT_WELD_TOLERANCE);
-    let topology = Topology::new(&welded.mesh);
     let mut stages = Vec::new();
     let skinned = skin(
-        &welded,
-        &topology,
-        &positions,
-        &skeleton,
+        input(&positions, &mesh.triangles, &skeleton),
         &SkinParams::default(),
         &mut |stage| stages.push(stage),
     )
     .expect("skinned");
-    assert_eq!(stages, [Stage::Decompose, Stage::Distances, Stage::Weights]);
+    assert_eq!(
+        stages,
+        [
+            Stage::Weld,
+            Stage::Topology,
+            Stage::Decompose,
+            Stage::Overlap,
+            Stage::Weights
+        ]
+    );
     assert_eq!(skinned.weights.vertex_count(), positions.len());
     assert_eq!(skinned.counts.weights.unreachable, 0);
     assert!(skinned.weights.max_influences() <= 4);
@@ -49,48 +66,52 @@ fn a_bent_tube_is_skinned_with_a_smooth_transition_at_its_joint() {
 fn bad_settings_are_refused_before_any_work() {
     let (mesh, skeleton) = bent_cylinder(0.5, 4.0, 60.0, 12, 4);
     let positions: Vec<Vec3> = mesh.positions.iter().map(|p| p.as_vec3()).collect();
-    let welded = weld(&positions, &mesh.triangles, DEFAULT_WELD_TOLERANCE);
-    let topology = Topology::new(&welded.mesh);
     let no_influences = SkinParams {
         max_influences: 0,
         ..SkinParams::default()
     };
     let mut unknown_joint = SkinParams::default();
-    unknown_joint
-        .weights
-        .overlap
-        .per_joint
-        .insert("elbow".into(), 0.5);
+    unknown_joint.overlap.per_joint.insert("elbow".into(), 0.5);
+    let mut bad_angle = SkinParams::default();
+    bad_angle.decompose.angle_step_deg = 90.0;
     let mut negative = SkinParams::default();
-    negative.weights.overlap.factor = -0.5;
+    negative.overlap.factor = -0.5;
     for (params, expected) in [
-        (no_influences, WeightsError::NoInfluences),
+        (
+            no_influences,
+            SkinError::Settings(SettingsError::NoInfluences),
+        ),
         (
             unknown_joint,
-            WeightsError::UnknownJoint {
+            SkinError::Overlap(OverlapError::UnknownJoint {
                 name: "elbow".into(),
-            },
+            }),
         ),
         (
             negative,
-            WeightsError::BadOverlapFactor {
+            SkinError::Overlap(OverlapError::BadFactor {
                 joint: None,
                 value: -0.5,
-            },
+            }),
+        ),
+        (
+            bad_angle,
+            SkinError::Decompose(DecomposeError::BadParameter {
+                name: "angle_step_deg",
+                value: 90.0,
+                expected: "0.1 ..= 45",
+            }),
         ),
     ] {
         let mut stages = Vec::new();
         let result = skin(
-            &welded,
-            &topology,
-            &positions,
-            &skeleton,
+            input(&positions, &mesh.triangles, &skeleton),
             &params,
             &mut |s| stages.push(s),
         );
         match result {
-            Err(SkinError::Weights(error)) => assert_eq!(error, expected),
-            other => panic!("expected {expected:?}, got {:?}", other.map(|_| ())),
+            Err(error) => assert_eq!(format!("{error:?}"), format!("{expected:?}")),
+            Ok(_) => panic!("expected {expected:?}, got weights"),
         }
         assert!(stages.is_empty());
     }

@@ -2,10 +2,11 @@
 //! rings of the mesh: invariants, mirror symmetry, no leak across touching parts, soft
 //! boundaries that stay on their own side of the surface.
 
-use atlas_skin::blend::Blend;
+use atlas_skin::fixtures::shapes::capsule_chain;
 use atlas_skin::overlap::{compute_overlaps, OverlapParams};
-use atlas_skin::shapes::capsule_chain;
-use atlas_skin::weights::{compute_weights, stored_weights, SurfaceWeights, WeightParams};
+use atlas_skin::pipeline::unweld_weights;
+use atlas_skin::weights::blend::Blend;
+use atlas_skin::weights::{compute_weights, SurfaceWeights};
 use atlas_skin::{
     Boundary, BoundaryKind, Decomposition, JointDecision, JointStatus, Region, SurfaceMesh,
     Topology,
@@ -173,13 +174,10 @@ fn decompose_by_hand(
 }
 
 fn weights_of(decomposition: &Decomposition, skeleton: &Skeleton, blend: Blend) -> SurfaceWeights {
-    let params = WeightParams {
-        overlap: OverlapParams::default(),
-        blend,
-    };
-    let overlaps = compute_overlaps(decomposition, skeleton, &params.overlap).expect("overlaps");
+    let overlaps =
+        compute_overlaps(decomposition, skeleton, &OverlapParams::default()).expect("overlaps");
     let (weights, counts) =
-        compute_weights(decomposition, skeleton, &overlaps, params.blend).expect("weights");
+        compute_weights(decomposition, skeleton, &overlaps, blend).expect("weights");
     assert_eq!(counts.unreachable, 0);
     weights
 }
@@ -480,7 +478,7 @@ fn a_mirror_symmetric_mesh_gets_mirror_symmetric_weights() {
 }
 
 #[test]
-fn stored_weights_keep_the_largest_influences_and_renormalise() {
+fn unwelded_weights_keep_the_largest_influences_and_renormalise() {
     let surface = SurfaceWeights {
         offsets: vec![0, 3, 4],
         joints: vec![0, 1, 2, 1],
@@ -493,17 +491,15 @@ fn stored_weights_keep_the_largest_influences_and_renormalise() {
     )
     .expect("skeleton");
     // Stored vertices: two copies of surface vertex 0, one of 1, one unreferenced near c.
-    let welded_of_stored = [0, 1, 0, atlas_skin::weld::UNREFERENCED];
+    let welded_of_stored = [0, 1, 0, atlas_skin::mesh::weld::UNREFERENCED];
     let positions = [Vec3::ZERO, Vec3::X, Vec3::ZERO, Vec3::new(2.4, 0.0, 0.0)];
-    let stored = stored_weights(&surface, &welded_of_stored, &positions, &skeleton, 2)
-        .expect("stored weights");
+    let stored = unweld_weights(&surface, &welded_of_stored, &positions, &skeleton, 2);
     assert_eq!(stored.vertex_count(), 4);
     let row: Vec<_> = stored.row(0).collect();
     assert_eq!(row.iter().map(|r| r.0).collect::<Vec<_>>(), vec![1, 2]);
     assert!((row[0].1 - 0.625).abs() < 1e-6 && (row[1].1 - 0.375).abs() < 1e-6);
     assert_eq!(stored.row(2).collect::<Vec<_>>(), row);
     assert_eq!(stored.row(3).collect::<Vec<_>>(), vec![(2, 1.0)]);
-    assert!(stored_weights(&surface, &welded_of_stored, &positions, &skeleton, 0).is_err());
 }
 
 #[test]

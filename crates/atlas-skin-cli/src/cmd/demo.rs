@@ -2,7 +2,7 @@
 
 use crate::input::demo_character;
 use anyhow::{Context, Result};
-use atlas_skin::nearest_bone::nearest_bone_weights;
+use atlas_skin::skeleton::bones::nearest_bone_weights;
 use atlas_skin_io::gltf::{write_skinned_glb, WriteOptions};
 use std::path::PathBuf;
 

@@ -1,10 +1,10 @@
 //! `atlas-skin eval`: compares candidate weights with reference (artist) weights on the same
 //! mesh: weight difference, deformation error, bleeding, validity
-//! ([`atlas_skin::eval`]).
+//! ([`atlas_skin_eval`]).
 
 use crate::input::{InputArgs, Prepared, ReadArgs};
 use anyhow::{Context, Result};
-use atlas_skin::eval::{evaluate, Animation, EvalInput, EvalOptions, Evaluation, Weighted};
+use atlas_skin_eval::{evaluate, Animation, EvalInput, EvalOptions, Evaluation, Weighted};
 use atlas_skin_io::{Character, LoadOptions};
 use std::path::PathBuf;
 
@@ -124,7 +124,7 @@ fn weighted<'a>(character: &'a Character, role: &str) -> Result<Weighted<'a>> {
 
 /// The figures as a few aligned lines.
 fn summary(e: &Evaluation) -> String {
-    let deform = |name: &str, d: Option<&atlas_skin::eval::DeformError>| match d {
+    let deform = |name: &str, d: Option<&atlas_skin_eval::DeformError>| match d {
         Some(d) => format!(
             "{name:<22} mean {:.4}  max {:.4}  (× diagonal)\n",
             d.mean, d.max
@@ -165,8 +165,8 @@ fn summary(e: &Evaluation) -> String {
 }
 
 /// One line of the worst-vertex list.
-fn worst_line(w: &atlas_skin::eval::WorstVertex) -> String {
-    let row = |r: &[atlas_skin::eval::JointWeight]| {
+fn worst_line(w: &atlas_skin_eval::WorstVertex) -> String {
+    let row = |r: &[atlas_skin_eval::JointWeight]| {
         r.iter()
             .map(|jw| format!("{} {:.2}", jw.joint, jw.weight))
             .collect::<Vec<_>>()

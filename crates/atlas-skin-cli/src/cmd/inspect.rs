@@ -3,7 +3,7 @@
 
 use crate::input::{InputArgs, Prepared};
 use anyhow::Result;
-use atlas_skin::winding::is_inside;
+use atlas_skin::mesh::winding::is_inside;
 use rayon::prelude::*;
 use serde::Serialize;
 

@@ -4,13 +4,12 @@
 
 use crate::input::InputArgs;
 use anyhow::{bail, Context, Result};
-use atlas_skin::blend::Blend;
-use atlas_skin::decomposition_report::{debug_colors, debug_lines};
-use atlas_skin::pipeline::{skin, SkinParams, Skinned, Stage};
-use atlas_skin::{weld, BoundaryKind, Topology};
+use atlas_skin::pipeline::{skin, SkinInput, SkinParams, Skinned, Stage};
+use atlas_skin::report::{debug_colors, debug_lines};
+use atlas_skin::weights::blend::Blend;
+use atlas_skin::BoundaryKind;
 use atlas_skin_io::gltf::{write_debug_glb, write_skinned_glb, WriteOptions};
 use atlas_skin_io::Character;
-use atlas_skin_runtime::Skeleton;
 use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::{json, Value};
@@ -29,8 +28,8 @@ pub struct Args {
     /// Write a JSON report: decomposition, overlap widths, timings, counts, warnings.
     #[arg(long, value_name = "R.json")]
     pub report: Option<PathBuf>,
-    /// Settings as JSON (any subset of `decompose`, `weights` {`overlap` {`factor`,
-    /// `per_joint`}, `blend`}, `max_influences`); the options below override it.
+    /// Settings as JSON (any subset of `decompose`, `overlap` {`factor`, `per_joint`},
+    /// `blend`, `max_influences`); the options below override it.
     #[arg(long, value_name = "FILE.json")]
     pub config: Option<PathBuf>,
     /// Overlap half-width as a multiple of each boundary's diameter (the paper: 0.5).
@@ -79,7 +78,7 @@ impl From<BlendArg> for Blend {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let mut params = params(&args)?;
+    let params = params(&args)?;
     let character = args.input.load()?;
     let Some(skeleton) = character.skeleton.clone() else {
         bail!(
@@ -87,38 +86,21 @@ pub fn run(args: Args) -> Result<()> {
             character.path.display()
         );
     };
-    forbid_end_joints(&mut params, &character, &skeleton);
     let mut timings = serde_json::Map::new();
-    let ms = |start: Instant| json!(start.elapsed().as_secs_f64() * 1e3);
-
     let progress = progress_bar();
-    progress.set_message("welding");
-    let start = Instant::now();
-    let welded = weld(
-        &character.mesh.positions,
-        &character.mesh.triangles,
-        atlas_skin::weld::DEFAULT_WELD_TOLERANCE,
-    );
-    timings.insert("weld".into(), ms(start));
-    let start = Instant::now();
-    let topology = Topology::new(&welded.mesh);
-    timings.insert("topology".into(), ms(start));
-
     let skinned = skin(
-        &welded,
-        &topology,
-        &character.mesh.positions,
-        &skeleton,
+        SkinInput {
+            positions: &character.mesh.positions,
+            triangles: &character.mesh.triangles,
+            skeleton: &skeleton,
+            end_joints: &character.end_joints,
+        },
         &params,
         &mut |stage: Stage| progress.set_message(stage.name()),
     )
     .with_context(|| format!("cannot skin {}", character.path.display()))?;
-    for (name, ms) in [
-        ("decompose", skinned.timings.decompose),
-        ("distances", skinned.timings.distances),
-        ("weights", skinned.timings.weights),
-    ] {
-        timings.insert(name.into(), json!(ms));
+    for &(stage, ms) in &skinned.timings.0 {
+        timings.insert(stage.name().into(), json!(ms));
     }
 
     progress.set_message("writing");
@@ -128,10 +110,10 @@ pub fn run(args: Args) -> Result<()> {
         ..WriteOptions::default()
     };
     write_skinned_glb(&character, &skinned.weights, &options, &args.output)?;
-    timings.insert("write".into(), ms(start));
+    timings.insert("write".into(), json!(start.elapsed().as_secs_f64() * 1e3));
     progress.finish_and_clear();
 
-    let report = report(&character, &welded.welded_of_stored, &skinned, timings);
+    let report = report(&character, &skinned, timings);
     if let Some(path) = &args.report {
         let text = serde_json::to_string_pretty(&report)?;
         atlas_skin_io::write_atomically(path, Some(&character.path), text.as_bytes())?;
@@ -171,7 +153,7 @@ fn params(args: &Args) -> Result<SkinParams> {
         None => SkinParams::default(),
     };
     if let Some(factor) = args.overlap {
-        params.weights.overlap.factor = factor;
+        params.overlap.factor = factor;
     }
     for entry in &args.overlap_joint {
         let Some((name, value)) = entry.rsplit_once('=') else {
@@ -180,14 +162,10 @@ fn params(args: &Args) -> Result<SkinParams> {
         let factor: f64 = value
             .parse()
             .with_context(|| format!("--overlap-joint {entry:?}: {value:?} is not a number"))?;
-        params
-            .weights
-            .overlap
-            .per_joint
-            .insert(name.to_string(), factor);
+        params.overlap.per_joint.insert(name.to_string(), factor);
     }
     if let Some(blend) = args.blend {
-        params.weights.blend = blend.into();
+        params.blend = blend.into();
     }
     if let Some(n) = args.max_influences {
         params.max_influences = n;
@@ -195,17 +173,6 @@ fn params(args: &Args) -> Result<SkinParams> {
     params.decompose.force.extend(args.force.iter().cloned());
     params.decompose.forbid.extend(args.forbid.iter().cloned());
     Ok(params)
-}
-
-/// Adds the input's end joints (TGF leaves, which move nothing) to the forbidden joints,
-/// unless the user forces them.
-fn forbid_end_joints(params: &mut SkinParams, character: &Character, skeleton: &Skeleton) {
-    for &j in &character.end_joints {
-        let name = &skeleton.names[j as usize];
-        if !params.decompose.force.contains(name) && !params.decompose.forbid.contains(name) {
-            params.decompose.forbid.push(name.clone());
-        }
-    }
 }
 
 /// A spinner with the current stage on stderr, hidden when stderr is not a terminal.
@@ -227,7 +194,6 @@ fn progress_bar() -> ProgressBar {
 /// `timings_ms`, `counts`, `warnings`.
 fn report(
     character: &Character,
-    welded_of_stored: &[u32],
     skinned: &Skinned,
     timings: serde_json::Map<String, Value>,
 ) -> Value {
@@ -256,7 +222,8 @@ fn report(
             }
         }
     }
-    decomposition_json["vertex_regions"] = json!(welded_of_stored
+    decomposition_json["vertex_regions"] = json!(skinned
+        .welded_of_stored
         .iter()
         .map(|&w| vertex_region.get(w as usize).copied().flatten())
         .collect::<Vec<_>>());

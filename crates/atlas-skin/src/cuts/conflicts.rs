@@ -1,0 +1,156 @@
+//! The conflict rule between cuts (§3.1; the paper leaves crossing cuts open, METHOD.md
+//! "Stage 1"): which joint keeps a closed cut and which falls back to a soft boundary.
+//!
+//! Conflict rule. Two curves conflict when they cross or touch: they run through a common
+//! vertex, or two of their chords in one face interleave or end within `snap_fraction` of
+//! each other along the face's boundary. Curves that merely pass through the same faces
+//! (parallel chords of a coarse mesh's large triangles) do not conflict. Joints are placed
+//! in increasing order of their best perimeter, so the small cross-sections of fingers,
+//! toes and distal limbs are placed before the palm, leg-root, neck and torso planes that
+//! would cross them; branching joints on the mirror plane (a spine joint where the legs or
+//! the arms branch) come after all others, whatever their perimeter. A joint whose best
+//! curve conflicts with an already placed one tries its next-best closed sections (the
+//! other sampled planes, by increasing perimeter); when none fits, it gets a soft boundary:
+//! its plane restricted to the region that holds it (METHOD.md, "extensions"), which the
+//! weights stage blends across; so does a joint that [`crate::cuts::joint_roles`] allows no cut.
+//! A joint is left without a boundary only for the reasons of [`crate::cuts::joint_roles`], or
+//! when no region holds it (an empty surface); the report says which.
+
+use super::joint_roles::{JointFrame, JointPlan};
+use super::plane_search::{CutCandidate, CutSearch};
+use super::plane_section::{Chord, CrossingPoint, SectionCurve};
+use crate::mesh::{SurfaceMesh, Topology};
+use atlas_skin_runtime::Skeleton;
+use std::collections::HashMap;
+
+/// Where the conflict rule put a joint's boundary.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Placement {
+    /// Index of the placed candidate.
+    Cut {
+        candidate: usize,
+        frame: JointFrame,
+    },
+    Soft {
+        reason: String,
+        frame: JointFrame,
+    },
+    Skip(String),
+}
+
+/// The conflict rule of the module doc. Returns one placement per joint.
+pub fn place_cuts(
+    mesh: &SurfaceMesh,
+    topology: &Topology,
+    skeleton: &Skeleton,
+    plans: &[JointPlan],
+    searches: &[CutSearch],
+    gap: f64,
+) -> Vec<Placement> {
+    let candidates: Vec<&[CutCandidate]> = searches.iter().map(|s| &s.candidates[..]).collect();
+    let on_mirror_plane =
+        |j: usize| matches!(&plans[j], JointPlan::Boundary(frame) if frame.on_mirror_plane);
+    let mut order: Vec<usize> = (0..plans.len())
+        .filter(|&j| matches!(plans[j], JointPlan::Boundary(_)) && !candidates[j].is_empty())
+        .collect();
+    order.sort_by(|&a, &b| {
+        on_mirror_plane(a).cmp(&on_mirror_plane(b)).then(
+            candidates[a][0]
+                .perimeter
+                .total_cmp(&candidates[b][0].perimeter),
+        )
+    });
+    let mut placed_chords: HashMap<u32, Vec<(u32, Chord)>> = HashMap::new();
+    let mut vertex_owner: HashMap<u32, u32> = HashMap::new();
+    let mut placed: Vec<Option<Result<usize, Vec<u32>>>> = vec![None; plans.len()];
+    for j in order {
+        let mut blockers: Vec<u32> = Vec::new();
+        let mut accepted = None;
+        for (k, candidate) in candidates[j].iter().enumerate() {
+            let chords: Vec<Chord> = candidate.curve.chords(mesh, topology).collect();
+            let vertices = curve_vertices(&candidate.curve);
+            let before = blockers.len();
+            blockers.extend(vertices.iter().filter_map(|v| vertex_owner.get(v).copied()));
+            for chord in &chords {
+                if let Some(others) = placed_chords.get(&chord.face) {
+                    blockers.extend(
+                        others
+                            .iter()
+                            .filter(|(_, other)| chord.crosses_or_touches(other, gap))
+                            .map(|(owner, _)| *owner),
+                    );
+                }
+            }
+            if blockers.len() == before {
+                for chord in chords {
+                    placed_chords
+                        .entry(chord.face)
+                        .or_default()
+                        .push((j as u32, chord));
+                }
+                vertex_owner.extend(vertices.into_iter().map(|v| (v, j as u32)));
+                accepted = Some(k);
+                break;
+            }
+        }
+        placed[j] = Some(accepted.ok_or(blockers));
+    }
+    plans
+        .iter()
+        .zip(placed)
+        .zip(searches)
+        .map(|((plan, placed), search)| {
+            let frame = match plan {
+                JointPlan::Skip(reason) | JointPlan::Exclude(reason) => {
+                    return Placement::Skip(reason.clone())
+                }
+                JointPlan::Soft(frame, reason) => {
+                    return Placement::Soft {
+                        reason: reason.clone(),
+                        frame: *frame,
+                    }
+                }
+                JointPlan::Boundary(frame) => *frame,
+            };
+            let reason = match placed {
+                Some(Ok(candidate)) => return Placement::Cut { candidate, frame },
+                Some(Err(mut blockers)) => {
+                    blockers.sort_unstable();
+                    blockers.dedup();
+                    let names: Vec<&str> = blockers
+                        .iter()
+                        .map(|&b| skeleton.names[b as usize].as_str())
+                        .collect();
+                    format!(
+                        "every closed section found crosses or touches the cut of {}",
+                        names.join(", ")
+                    )
+                }
+                None if search.enclosing_other_bones > 0 => format!(
+                    "each of the {} closed sections around the joint also encloses another bone \
+                     (a plane across a palm, a foot or the torso)",
+                    search.enclosing_other_bones
+                ),
+                None => "no closed cross-section around the joint near it (open surface, \
+                         joint outside, or a section reaching far from the joint)"
+                    .into(),
+            };
+            Placement::Soft { reason, frame }
+        })
+        .collect()
+}
+
+/// The surface vertices a curve runs through.
+fn curve_vertices(curve: &SectionCurve) -> Vec<u32> {
+    let mut vertices: Vec<u32> = curve
+        .crossings
+        .iter()
+        .filter_map(|c| match c.point {
+            CrossingPoint::Vertex(v) => Some(v),
+            CrossingPoint::Interior(_) => None,
+        })
+        .collect();
+    vertices.sort_unstable();
+    vertices.dedup();
+    vertices
+}

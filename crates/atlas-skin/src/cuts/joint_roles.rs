@@ -1,0 +1,483 @@
+//! Which joints get a boundary (Lu et al. 2008 §3.1, and METHOD.md "Measured on real rigs").
+//!
+//! The rules, in the order they are applied to joint J at bind position p_J:
+//! 1. Forbidden by the user: no boundary, and no skin at all ([`JointPlan::Exclude`]).
+//!    Forced by the user: a boundary, whatever follows.
+//! 2. A root has no upper bone to cut: its region is the root region. A joint whose bones
+//!    all have zero length has no direction to cut across: no boundary.
+//! 3. A joint lies outside the mesh and owns no geometry when it is farther from the
+//!    surface than `outside_ratio` × its longest bone and outside it: most of six rays from
+//!    it (±x, ±y, ±z, slightly turned) first meet the surface from outside, or not at all.
+//!    Then: no boundary and no skin ([`JointPlan::Exclude`]). A joint near the surface (a
+//!    face bone in an eye socket) keeps its boundary: the skin around it is its to move. A
+//!    winding number is not used: it fails on open and multi-piece meshes; the ray vote
+//!    needs only a locally outward surface.
+//! 4. A branching joint (two or more children) on the skeleton's mirror plane (pelvis,
+//!    chest, head, jaw). The paper gives it no boundary; here (METHOD.md, "extensions") it
+//!    gets one when it owns a part of the trunk. Nearer to the surface than a quarter of its
+//!    shortest bone (a jaw or tongue root in the mouth) it lies at the skin, not in a trunk:
+//!    no boundary. (Measured on makehuman: the weights stage keeps a soft boundary on the
+//!    part nearest its own bones, so the jaw's own weight no longer bleeds and `--force
+//!    jaw` changes nothing measurable; but a second branching joint at the same point,
+//!    whose bones run forward to the upper lip, takes the lip the artist leaves to the
+//!    head: bleeding .020 → .026 without this rule.) Otherwise where its branches start is
+//!    judged against its section's diameter D = 2 × surface distance. Most child bones (the
+//!    median) shorter than D: it sits at the junction (a chest between shoulders and neck),
+//!    its children's boundaries enclose most of it, so no cut fits; but the trunk below them
+//!    bends with it, as artists weight it: a soft boundary only (its branches take their
+//!    parts from the whole chain below it, see [`crate::weights`]; measured on cesiumman,
+//!    weight L1 .212 → .181, and on riggedfigure .552 → .434, against no boundary). Some
+//!    child bone shorter than D: any plane through it slices that branch's root: a soft
+//!    boundary only. Otherwise its cut is searched like any other but placed after all
+//!    others ([`JointFrame::on_mirror_plane`]), and it is soft when no clean cut fits.
+//!    Off the plane (a clavicle with a breast bone, a wrist with five finger bones) a
+//!    branching joint is cut like a chain joint whose lower bone is the mean of its unit
+//!    child directions — for a wrist, the average finger direction.
+//! 5. A leaf owns geometry when the surface runs on past it. Either test suffices:
+//!    (a) the ray from p_J along the upper bone u leaves the surface from inside (hit face
+//!    normal along the ray on an outward-oriented surface) at a distance ≥
+//!    `leaf_extent_ratio` × r, r the joint's surface distance; (b) for a joint inside the
+//!    body (r ≥ a tenth of its bone), the part of the surface nearest to it — vertices v past
+//!    it within 60° of u, (v − p_J) · u ≥ ½ |v − p_J|, nearer to p_J than to every bone not
+//!    at J — reaches farther than 2 r from p_J. (b) finds toes beyond the ball of a foot, which (a) misses when the foot
+//!    bone points down into the sole. It is then cut with lower bone = upper bone.
+//!    Otherwise it is an end site (a fingertip cap reaches about 1.4–1.7 r): no boundary.
+//! 6. Twist and helper joints on a straight bone are chain joints with collinear bones: they
+//!    are cut perpendicular to the bone (the cone search), and the weights stage blends the
+//!    regions of one limb; nothing tells them apart from a straight elbow geometrically.
+//!
+//! The mirror plane is inferred from joint positions alone (names are not used): the plane
+//! x · n = c, among the coordinate planes and the bisector planes of sibling pairs of equal
+//! bone length, that maps the joint set best onto itself.
+
+use super::params::{DecomposeParams, Override};
+use crate::geometry::point_segment_distance;
+use crate::mesh::spatial_index::FaceSpheres;
+use crate::mesh::SurfaceMesh;
+use crate::skeleton::bones::{bones_not_at, joint_pairs};
+use atlas_skin_runtime::Skeleton;
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// The skeleton's mirror plane: points x with n · x = `offset`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SymmetryPlane {
+    pub normal: DVec3,
+    pub offset: f64,
+    /// Mean distance from a reflected joint to the nearest joint, relative to the
+    /// skeleton's bounding-box diagonal.
+    pub mismatch: f64,
+}
+
+/// The bones around a joint that gets a boundary.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointFrame {
+    /// p_J.
+    pub position: DVec3,
+    /// Unit direction of the upper bone (parent → J).
+    pub upper: DVec3,
+    /// Unit direction of the lower bone (J → child, see the rules).
+    pub lower: DVec3,
+    /// Length of the shortest non-zero adjacent bone.
+    pub bone_length: f64,
+    /// Distance from p_J to the nearest surface point.
+    pub surface_distance: f64,
+    /// A branching joint on the skeleton's mirror plane (pelvis, chest, head): its plane
+    /// crosses the trunk where limbs branch, so it is placed after every other cut.
+    pub on_mirror_plane: bool,
+}
+
+/// What the decomposition does at one joint.
+#[derive(Debug, Clone, PartialEq)]
+pub enum JointPlan {
+    /// Search a cut (and fall back to a soft boundary).
+    Boundary(JointFrame),
+    /// A soft boundary only, never a cut, with the reason for the report.
+    Soft(JointFrame, String),
+    /// No boundary, with the reason for the report.
+    Skip(String),
+    /// No boundary and no skin at all (forbidden by the user, or outside the mesh), with
+    /// the reason for the report.
+    Exclude(String),
+}
+
+/// A joint is on the mirror plane within this fraction of the fit tolerance: a pelvis or
+/// chest sits on it to rounding, while the branching joints of an eye or a cheek lie a
+/// few percent of the skeleton's size off it.
+const ON_PLANE: f64 = 0.25;
+
+/// Rule 5 (b): the part of the surface nearest to a leaf owns geometry when it reaches this
+/// many times the joint's surface distance past it (a toe beyond the ball of a foot reaches
+/// 2–7 times; a fingertip cap around an end site about 1.4–1.7 times).
+const LEAF_REACH_RATIO: f64 = 2.0;
+
+/// Rule 4: a branching joint on the mirror plane lies in a trunk when its surface distance
+/// is at least this fraction of its shortest bone.
+const TRUNK_DEPTH: f64 = 0.25;
+
+/// Rule 5 (b) counts the vertices within 60° of the leaf's bone (cos 60° = ½): toes turn
+/// about 45° from a foot bone, while the rim of a broad flat end (a pad under an end site)
+/// lies across it.
+const PAST_COSINE: f64 = 0.5;
+
+/// Rule 5 (b) applies to a joint at least this fraction of its bone from the surface; one
+/// nearer lies in the skin (a face bone): the part nearest to it is a patch of skin, not a
+/// part of the body past it.
+const INTERIOR_RADIUS: f64 = 0.1;
+
+/// Bones shorter than this fraction of the skeleton's diagonal have no direction.
+const ZERO_BONE: f64 = 1e-9;
+
+/// Decides, for every joint of `skeleton` (bind positions `positions`), whether it gets a
+/// boundary; `overrides` has one entry per joint.
+pub fn plan_joints(
+    mesh: &SurfaceMesh,
+    spheres: &FaceSpheres,
+    skeleton: &Skeleton,
+    positions: &[DVec3],
+    overrides: &[Option<Override>],
+    params: &DecomposeParams,
+) -> Vec<JointPlan> {
+    let children = skeleton.children();
+    let scale = diagonal(positions).max(f64::MIN_POSITIVE);
+    let symmetry = infer_symmetry_plane(skeleton, positions, params.symmetry_tolerance);
+    let orientation = orientation_sign(mesh);
+    let bones = joint_pairs(skeleton, positions);
+    (0..skeleton.len())
+        .into_par_iter()
+        .map(|j| {
+            let forced = overrides[j] == Some(Override::Force);
+            if overrides[j] == Some(Override::Forbid) {
+                return JointPlan::Exclude("forbidden by the user".into());
+            }
+            let p = positions[j];
+            let parent = skeleton.parent(j);
+            if parent.is_none() && !forced {
+                return JointPlan::Skip("root joint: no upper bone to cut".into());
+            }
+            let upper_vector = parent.map_or(DVec3::ZERO, |q| p - positions[q]);
+            let child_vectors: Vec<DVec3> = children[j]
+                .iter()
+                .map(|&c| positions[c] - p)
+                .filter(|v| v.length() > ZERO_BONE * scale)
+                .collect();
+            let lower_mean: DVec3 = child_vectors.iter().map(|v| v.normalize()).sum();
+            let upper = if upper_vector.length() > ZERO_BONE * scale {
+                upper_vector.normalize()
+            } else {
+                lower_mean.normalize_or_zero()
+            };
+            let lower = lower_mean.try_normalize().unwrap_or(upper);
+            if upper == DVec3::ZERO {
+                return JointPlan::Skip("zero-length bones: no direction to cut across".into());
+            }
+            let bone_length = std::iter::once(upper_vector.length())
+                .chain(child_vectors.iter().map(|v| v.length()))
+                .filter(|&l| l > ZERO_BONE * scale)
+                .fold(f64::INFINITY, f64::min);
+            let longest_bone = std::iter::once(upper_vector.length())
+                .chain(child_vectors.iter().map(|v| v.length()))
+                .fold(0.0, f64::max);
+            let surface_distance = spheres.nearest_distance(mesh, p);
+            let on_mirror_plane = child_vectors.len() >= 2
+                && symmetry.is_some_and(|plane| {
+                    (plane.normal.dot(p) - plane.offset).abs()
+                        <= ON_PLANE * params.symmetry_tolerance * scale
+                });
+            let frame = JointFrame {
+                on_mirror_plane,
+                position: p,
+                upper,
+                lower,
+                bone_length,
+                surface_distance,
+            };
+            if forced {
+                return JointPlan::Boundary(frame);
+            }
+            if surface_distance > params.outside_ratio * longest_bone
+                && !is_inside_by_rays(mesh, spheres, p, orientation)
+            {
+                return JointPlan::Exclude(format!(
+                    "outside the mesh, owns no geometry: nearest surface {surface_distance:.4} \
+                     away, longest bone {longest_bone:.4}"
+                ));
+            }
+            if on_mirror_plane {
+                let mut child_lengths: Vec<f64> =
+                    child_vectors.iter().map(|v| v.length()).collect();
+                child_lengths.sort_unstable_by(f64::total_cmp);
+                let section_diameter = 2.0 * surface_distance;
+                if surface_distance < TRUNK_DEPTH * bone_length {
+                    return JointPlan::Skip(format!(
+                        "branching joint on the mirror plane near the skin, not in a trunk: \
+                         surface {surface_distance:.4} away, shortest bone {bone_length:.4}"
+                    ));
+                }
+                if child_lengths[child_lengths.len() / 2] < section_diameter {
+                    return JointPlan::Soft(
+                        frame,
+                        format!(
+                            "branching joint on the mirror plane at the junction of its branches: \
+                         most of them start within its cross-section (median child bone \
+                         {:.4}, section diameter about {section_diameter:.4}): no cut fits",
+                            child_lengths[child_lengths.len() / 2]
+                        ),
+                    );
+                }
+                if child_lengths[0] < section_diameter {
+                    return JointPlan::Soft(
+                        frame,
+                        format!(
+                            "branching joint on the mirror plane with a branch starting within \
+                             its cross-section (child bone {:.4}, section diameter about \
+                             {section_diameter:.4}): a plane there would cut across it",
+                            child_lengths[0]
+                        ),
+                    );
+                }
+            }
+            if children[j].is_empty() {
+                let owns = leaf_owns_geometry(
+                    mesh,
+                    spheres,
+                    &frame,
+                    &bones_not_at(&bones, positions, j),
+                    orientation,
+                    params.leaf_extent_ratio,
+                );
+                if !owns {
+                    return JointPlan::Skip(
+                        "end site: the surface does not run on past the joint".into(),
+                    );
+                }
+            }
+            JointPlan::Boundary(frame)
+        })
+        .collect()
+}
+
+/// Rule 5: whether the leaf of `frame` owns geometry. `other_bones`: the bones not at the
+/// leaf, as segments; `orientation` as from [`orientation_sign`].
+fn leaf_owns_geometry(
+    mesh: &SurfaceMesh,
+    spheres: &FaceSpheres,
+    frame: &JointFrame,
+    other_bones: &[[DVec3; 2]],
+    orientation: f64,
+    extent_ratio: f64,
+) -> bool {
+    let (p, upper, radius) = (frame.position, frame.upper, frame.surface_distance);
+    let threshold = extent_ratio * radius;
+    let exit_along_bone = spheres
+        .first_hit(mesh, p, upper)
+        .filter(|hit| orientation * mesh.scaled_normal(hit.face as usize).dot(upper) >= 0.0);
+    if exit_along_bone.is_some_and(|hit| hit.distance >= threshold) {
+        return true;
+    }
+    if radius < INTERIOR_RADIUS * frame.bone_length {
+        return false;
+    }
+    let reach_threshold = LEAF_REACH_RATIO * radius;
+    leaf_reach(mesh, spheres, p, upper, other_bones, 2.0 * reach_threshold) >= reach_threshold
+}
+
+/// The largest distance from `p` of the surface vertices v within `radius` of it that lie
+/// past it within 60° of the unit `direction` ((v − p) · direction ≥ ½ |v − p|) and nearer
+/// to `p` than to each bone of `other_bones`: how far the part beyond a leaf joint reaches.
+fn leaf_reach(
+    mesh: &SurfaceMesh,
+    spheres: &FaceSpheres,
+    p: DVec3,
+    direction: DVec3,
+    other_bones: &[[DVec3; 2]],
+    radius: f64,
+) -> f64 {
+    let mut vertices: Vec<u32> = spheres
+        .faces_near(p, radius)
+        .into_iter()
+        .flat_map(|f| mesh.triangles[f as usize])
+        .collect();
+    vertices.sort_unstable();
+    vertices.dedup();
+    vertices
+        .into_iter()
+        .map(|v| mesh.positions[v as usize])
+        .filter(|&v| {
+            (v - p).dot(direction) >= PAST_COSINE * v.distance(p) && v.distance(p) <= radius
+        })
+        .filter(|&v| {
+            let d = v.distance(p);
+            other_bones
+                .iter()
+                .all(|&[a, b]| point_segment_distance(v, a, b) > d)
+        })
+        .map(|v| v.distance(p))
+        .fold(0.0, f64::max)
+}
+
+/// Whether at least four of six rays from `p` first meet the surface leaving it (the hit
+/// face's normal, times `orientation`, along the ray). The directions are the axes turned
+/// by a small irrational rotation so that they do not run along axis-aligned edges.
+fn is_inside_by_rays(
+    mesh: &SurfaceMesh,
+    spheres: &FaceSpheres,
+    p: DVec3,
+    orientation: f64,
+) -> bool {
+    let turn = glam::DQuat::from_euler(glam::EulerRot::XYZ, 0.1234, 0.2345, 0.3456);
+    let exits = [
+        DVec3::X,
+        -DVec3::X,
+        DVec3::Y,
+        -DVec3::Y,
+        DVec3::Z,
+        -DVec3::Z,
+    ]
+    .into_iter()
+    .filter(|&axis| {
+        let direction = turn * axis;
+        spheres.first_hit(mesh, p, direction).is_some_and(|hit| {
+            orientation * mesh.scaled_normal(hit.face as usize).dot(direction) > 0.0
+        })
+    })
+    .count();
+    exits >= 4
+}
+
+/// +1 for an outward-oriented closed surface, −1 for an inward one, 0 when the signed
+/// volume Σ a · (b × c) / 6 is negligible (open strips): ray hits are then not filtered.
+fn orientation_sign(mesh: &SurfaceMesh) -> f64 {
+    let volume = mesh.signed_volume();
+    if volume.abs() <= 1e-9 * mesh.diagonal().powi(3) {
+        0.0
+    } else {
+        volume.signum()
+    }
+}
+
+fn diagonal(points: &[DVec3]) -> f64 {
+    let (lo, hi) = crate::geometry::bounding_box(points);
+    (hi - lo).length()
+}
+
+/// The mirror plane of the joint set, if one maps it onto itself within `tolerance` × the
+/// skeleton's diagonal (mean nearest-joint distance of the reflected joints) and reflects at
+/// least one pair of joints onto each other.
+///
+/// Candidates: normals ±x, ±y, ±z and p_i − p_j for sibling joints i, j whose bones have
+/// equal length (within 5%); offset c = median of n · p over the joints. O(J² · candidates).
+pub fn infer_symmetry_plane(
+    skeleton: &Skeleton,
+    positions: &[DVec3],
+    tolerance: f64,
+) -> Option<SymmetryPlane> {
+    let scale = diagonal(positions);
+    if positions.len() < 3 || scale <= 0.0 {
+        return None;
+    }
+    let mut normals = vec![DVec3::X, DVec3::Y, DVec3::Z];
+    for siblings in skeleton.children() {
+        for (k, &a) in siblings.iter().enumerate() {
+            for &b in &siblings[k + 1..] {
+                let Some(p) = skeleton.parent(a) else {
+                    continue;
+                };
+                let (la, lb) = (
+                    positions[a].distance(positions[p]),
+                    positions[b].distance(positions[p]),
+                );
+                if (la - lb).abs() <= 0.05 * la.max(lb) {
+                    if let Some(n) = (positions[a] - positions[b]).try_normalize() {
+                        normals.push(n);
+                    }
+                }
+            }
+        }
+        if normals.len() > 24 {
+            break;
+        }
+    }
+    normals
+        .into_iter()
+        .filter_map(|normal| {
+            let mut heights: Vec<f64> = positions.iter().map(|p| normal.dot(*p)).collect();
+            heights.sort_unstable_by(f64::total_cmp);
+            let offset = heights[heights.len() / 2];
+            let mut paired = 0;
+            let mut total = 0.0;
+            for p in positions {
+                let height = normal.dot(*p) - offset;
+                let mirrored = *p - 2.0 * height * normal;
+                total += positions
+                    .iter()
+                    .map(|q| q.distance(mirrored))
+                    .fold(f64::INFINITY, f64::min);
+                if height.abs() > tolerance * scale {
+                    paired += 1;
+                }
+            }
+            let mismatch = total / positions.len() as f64 / scale;
+            (paired >= 2 && mismatch <= tolerance).then_some(SymmetryPlane {
+                normal,
+                offset,
+                mismatch,
+            })
+        })
+        .min_by(|a, b| a.mismatch.total_cmp(&b.mismatch))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use atlas_skin_runtime::NO_PARENT;
+
+    /// A stick figure: pelvis (root) with spine and two legs, chest with neck and two arms.
+    fn stick_figure(tilt: f64) -> (Skeleton, Vec<DVec3>) {
+        let raw = [
+            ("pelvis", NO_PARENT, [0.0, 1.0, 0.0]),
+            ("chest", 0, [0.0, 1.5, 0.0]),
+            ("neck", 1, [0.0, 1.7, 0.0]),
+            ("arm.L", 1, [0.3, 1.5, 0.0]),
+            ("hand.L", 3, [0.8, 1.4, 0.0]),
+            ("arm.R", 1, [-0.3, 1.5, 0.0]),
+            ("hand.R", 5, [-0.8, 1.4, 0.0]),
+            ("leg.L", 0, [0.1, 0.9, 0.0]),
+            ("foot.L", 7, [0.1, 0.0, 0.1]),
+            ("leg.R", 0, [-0.1, 0.9, 0.0]),
+            ("foot.R", 9, [-0.1, 0.0, 0.1]),
+        ];
+        let rotation = glam::DQuat::from_rotation_y(tilt);
+        let positions: Vec<DVec3> = raw
+            .iter()
+            .map(|r| rotation * DVec3::from_array(r.2))
+            .collect();
+        let skeleton = Skeleton::from_positions(
+            raw.iter().map(|r| r.0.to_string()).collect(),
+            raw.iter().map(|r| r.1).collect(),
+            &positions.iter().map(|p| p.as_vec3()).collect::<Vec<_>>(),
+        )
+        .expect("valid skeleton");
+        (skeleton, positions)
+    }
+
+    #[test]
+    fn mirror_plane_of_a_stick_figure_is_found_even_when_rotated() {
+        for tilt in [0.0, 0.4] {
+            let (skeleton, positions) = stick_figure(tilt);
+            let plane = infer_symmetry_plane(&skeleton, &positions, 0.02).expect("symmetric");
+            let expected = glam::DQuat::from_rotation_y(tilt) * DVec3::X;
+            assert!(plane.normal.dot(expected).abs() > 0.999, "{plane:?}");
+            assert!(plane.offset.abs() < 1e-6 && plane.mismatch < 1e-6);
+        }
+    }
+
+    #[test]
+    fn a_lopsided_skeleton_has_no_mirror_plane() {
+        let (mut skeleton, mut positions) = stick_figure(0.0);
+        positions[4] = DVec3::new(0.6, 2.0, 0.5);
+        positions[8] = DVec3::new(0.5, 0.3, -0.6);
+        skeleton.inverse_bind[4] = glam::Mat4::from_translation(-positions[4].as_vec3());
+        assert!(infer_symmetry_plane(&skeleton, &positions, 0.02).is_none());
+    }
+}

@@ -1,0 +1,482 @@
+//! Exact intersection of a plane with part of a triangle surface, chained into closed
+//! curves (Lu et al. 2008 §3.1: "intersecting edges" chained into boundary curves).
+//!
+//! Sign rule. Vertex v has the signed distance d(v) = n · (x_v − o) to the plane through o
+//! with unit normal n, snapped to 0 when |d(v)| < ε_v (ε_v = snap fraction × the longest
+//! edge at v). A vertex is on the positive side when d(v) ≥ 0, so a vertex on the plane
+//! counts as positive. An edge is crossed when its ends have different sides; its crossing
+//! point is the end with d = 0 if there is one, else the interior point at
+//! t = d(a) / (d(a) − d(b)) from a. Every triangle then has exactly 0 or 2 crossed edges, and
+//! the crossing point of an edge depends on the edge alone, so curves chain without gaps and
+//! faces split without slivers: an interior point has t ∈ [ε, 1 − ε] relative to the edge.
+
+use crate::mesh::{SurfaceMesh, Topology};
+use glam::DVec3;
+
+/// A plane through `point` with unit `normal`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Plane {
+    pub point: DVec3,
+    pub normal: DVec3,
+}
+
+impl Plane {
+    /// n · (p − o).
+    pub fn signed_distance(&self, p: DVec3) -> f64 {
+        self.normal.dot(p - self.point)
+    }
+}
+
+/// Where a curve crosses an edge.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum CrossingPoint {
+    /// At a vertex of the surface (on the plane after snapping).
+    Vertex(u32),
+    /// Inside edge `edges[e] = [a, b]`, at `a + t (b − a)`, with t ∈ (0, 1).
+    Interior(f64),
+}
+
+/// One crossed edge of a curve.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EdgeCrossing {
+    pub edge: u32,
+    pub point: CrossingPoint,
+}
+
+impl EdgeCrossing {
+    /// Position of the crossing point.
+    pub fn position(&self, mesh: &SurfaceMesh, topology: &Topology) -> DVec3 {
+        match self.point {
+            CrossingPoint::Vertex(v) => mesh.positions[v as usize],
+            CrossingPoint::Interior(t) => {
+                let [a, b] = topology.edges[self.edge as usize];
+                mesh.positions[a as usize].lerp(mesh.positions[b as usize], t)
+            }
+        }
+    }
+}
+
+/// A closed curve: crossed edges in chain order. Consecutive crossings at the same vertex
+/// are kept, one per edge.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SectionCurve {
+    pub crossings: Vec<EdgeCrossing>,
+    /// `faces[i]` holds the segment from crossing i to crossing i + 1 (cyclically).
+    pub faces: Vec<u32>,
+}
+
+/// The segment of a curve inside one face, its ends as positions along the face's
+/// boundary: s = k + τ on local edge k (from corner k to corner k + 1, τ ∈ [0, 1)), so a
+/// corner k is s = k. Two chords of one face cross when their ends interleave on [0, 3).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Chord {
+    pub face: u32,
+    pub ends: [f64; 2],
+}
+
+/// The faces a section is computed on (near one joint), with buffers reused by every
+/// query. A query computes the signed distance and side of the domain's vertices only and
+/// scans the domain's faces by local vertex index; only the few crossed faces are traced
+/// through the mesh's topology, with #E visit stamps and #V, #F lookups of the whole mesh
+/// (zeroed allocations, set once per domain).
+#[derive(Debug, Clone)]
+pub struct SectionDomain {
+    faces: Vec<u32>,
+    /// The domain's faces as triples of local vertex indices.
+    local_faces: Vec<[u32; 3]>,
+    /// Per local vertex: its position, snap distance, signed distance and side (1 when
+    /// d ≥ 0, else 0: a face is crossed when its corners' sides sum to 1 or 2).
+    local_positions: Vec<DVec3>,
+    local_snap: Vec<f64>,
+    local_distance: Vec<f64>,
+    local_side: Vec<u8>,
+    /// Per global vertex: 1 + its local index, 0 outside the domain.
+    local_of: Vec<u32>,
+    in_domain: Vec<bool>,
+    edge_stamp: Vec<u32>,
+    stamp: u32,
+}
+
+/// Snap distance of every vertex: `fraction` × its longest incident edge (0 for an isolated
+/// vertex).
+pub fn vertex_snap_distances(mesh: &SurfaceMesh, topology: &Topology, fraction: f64) -> Vec<f64> {
+    let mut snap = vec![0.0f64; mesh.vertex_count()];
+    for &[a, b] in &topology.edges {
+        let length = mesh.positions[a as usize].distance(mesh.positions[b as usize]);
+        for v in [a, b] {
+            snap[v as usize] = snap[v as usize].max(fraction * length);
+        }
+    }
+    snap
+}
+
+impl SectionDomain {
+    /// A domain of `faces` of `mesh`; faces with a repeated vertex index are left out (a
+    /// curve reaching them is open).
+    pub fn new(
+        mesh: &SurfaceMesh,
+        topology: &Topology,
+        vertex_snap: &[f64],
+        faces: Vec<u32>,
+    ) -> Self {
+        let faces: Vec<u32> = faces
+            .into_iter()
+            .filter(|&f| {
+                let [a, b, c] = mesh.triangles[f as usize];
+                a != b && b != c && a != c
+            })
+            .collect();
+        let mut in_domain = vec![false; mesh.triangle_count()];
+        let mut local_of = vec![0u32; mesh.vertex_count()];
+        let mut vertices = Vec::new();
+        let local_faces = faces
+            .iter()
+            .map(|&f| {
+                in_domain[f as usize] = true;
+                mesh.triangles[f as usize].map(|v| {
+                    let slot = &mut local_of[v as usize];
+                    if *slot == 0 {
+                        vertices.push(v);
+                        *slot = vertices.len() as u32;
+                    }
+                    *slot - 1
+                })
+            })
+            .collect();
+        Self {
+            faces,
+            local_faces,
+            local_positions: vertices
+                .iter()
+                .map(|&v| mesh.positions[v as usize])
+                .collect(),
+            local_snap: vertices.iter().map(|&v| vertex_snap[v as usize]).collect(),
+            local_distance: vec![0.0; vertices.len()],
+            local_side: vec![0; vertices.len()],
+            local_of,
+            in_domain,
+            edge_stamp: vec![0; topology.edges.len()],
+            stamp: 0,
+        }
+    }
+
+    /// The closed curves in which `plane` meets the domain's faces. A chain that leaves the
+    /// domain (a face outside it, a boundary or non-manifold edge) is open and dropped.
+    /// Cost O(faces of the domain).
+    pub fn closed_sections(&mut self, topology: &Topology, plane: &Plane) -> Vec<SectionCurve> {
+        for ((d, side), (p, snap)) in self
+            .local_distance
+            .iter_mut()
+            .zip(&mut self.local_side)
+            .zip(self.local_positions.iter().zip(&self.local_snap))
+        {
+            let signed = plane.signed_distance(*p);
+            *d = if signed.abs() < *snap { 0.0 } else { signed };
+            *side = u8::from(*d >= 0.0);
+        }
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            self.edge_stamp.fill(0);
+            self.stamp = 1;
+        }
+        let mut curves = Vec::new();
+        for i in 0..self.faces.len() {
+            let [a, b, c] = self.local_faces[i];
+            let sides = self.local_side[a as usize]
+                + self.local_side[b as usize]
+                + self.local_side[c as usize];
+            if sides == 0 || sides == 3 {
+                continue;
+            }
+            let f = self.faces[i] as usize;
+            for &e in &topology.face_edges[f] {
+                if self.edge_stamp[e as usize] != self.stamp && self.is_crossed(topology, e) {
+                    if let Some(curve) = self.trace(topology, e) {
+                        curves.push(curve);
+                    }
+                }
+            }
+        }
+        curves
+    }
+
+    /// Local index of global vertex `v`, a corner of a domain face.
+    fn local(&self, v: u32) -> usize {
+        self.local_of[v as usize] as usize - 1
+    }
+
+    fn is_crossed(&self, topology: &Topology, e: u32) -> bool {
+        let [a, b] = topology.edges[e as usize];
+        self.local_side[self.local(a)] != self.local_side[self.local(b)]
+    }
+
+    fn crossing(&self, topology: &Topology, e: u32) -> EdgeCrossing {
+        let [a, b] = topology.edges[e as usize];
+        let (da, db) = (
+            self.local_distance[self.local(a)],
+            self.local_distance[self.local(b)],
+        );
+        let point = if da == 0.0 {
+            CrossingPoint::Vertex(a)
+        } else if db == 0.0 {
+            CrossingPoint::Vertex(b)
+        } else {
+            CrossingPoint::Interior(da / (da - db))
+        };
+        EdgeCrossing { edge: e, point }
+    }
+
+    /// The face across edge `e` from `from`, if `e` is manifold and that face is in the domain.
+    fn face_across(&self, topology: &Topology, e: u32, from: Option<u32>) -> Option<u32> {
+        let faces = topology.faces_of_edge(e as usize);
+        if faces.len() != 2 || !faces.iter().all(|&f| self.in_domain[f as usize]) {
+            return None;
+        }
+        match from {
+            Some(g) if faces[0] == g => Some(faces[1]),
+            Some(_) => Some(faces[0]),
+            None => Some(faces[0]),
+        }
+    }
+
+    /// Follows the chain from crossed edge `start`; `Some` when it closes on `start`.
+    fn trace(&mut self, topology: &Topology, start: u32) -> Option<SectionCurve> {
+        self.edge_stamp[start as usize] = self.stamp;
+        let mut crossings = vec![self.crossing(topology, start)];
+        let mut faces = Vec::new();
+        let (mut edge, mut from) = (start, None);
+        loop {
+            let face = self.face_across(topology, edge, from)?;
+            let mut others = topology.face_edges[face as usize]
+                .iter()
+                .copied()
+                .filter(|&g| g != edge && self.is_crossed(topology, g));
+            let next = others.next()?;
+            if others.next().is_some() {
+                return None;
+            }
+            faces.push(face);
+            if next == start {
+                return Some(SectionCurve { crossings, faces });
+            }
+            if self.edge_stamp[next as usize] == self.stamp {
+                return None;
+            }
+            self.edge_stamp[next as usize] = self.stamp;
+            crossings.push(self.crossing(topology, next));
+            (edge, from) = (next, Some(face));
+        }
+    }
+}
+
+impl SectionCurve {
+    /// Crossing positions in chain order.
+    pub fn positions(&self, mesh: &SurfaceMesh, topology: &Topology) -> Vec<DVec3> {
+        self.crossings
+            .iter()
+            .map(|c| c.position(mesh, topology))
+            .collect()
+    }
+
+    /// The curve's segments as chords of their faces; a segment whose ends are one vertex
+    /// (the curve running through a vertex) is no chord and is left out.
+    pub fn chords<'a>(
+        &'a self,
+        mesh: &'a SurfaceMesh,
+        topology: &'a Topology,
+    ) -> impl Iterator<Item = Chord> + 'a {
+        let n = self.crossings.len();
+        (0..n).filter_map(move |i| {
+            let (a, b) = (self.crossings[i], self.crossings[(i + 1) % n]);
+            if matches!((a.point, b.point), (CrossingPoint::Vertex(u), CrossingPoint::Vertex(v)) if u == v)
+            {
+                return None;
+            }
+            let face = self.faces[i];
+            Some(Chord {
+                face,
+                ends: [a, b].map(|c| boundary_position(mesh, topology, face, c)),
+            })
+        })
+    }
+}
+
+/// Position of a crossing along the boundary of `face` (see [`Chord`]).
+fn boundary_position(mesh: &SurfaceMesh, topology: &Topology, face: u32, c: EdgeCrossing) -> f64 {
+    let t = mesh.triangles[face as usize];
+    match c.point {
+        CrossingPoint::Vertex(v) => t.iter().position(|&w| w == v).unwrap_or(0) as f64,
+        CrossingPoint::Interior(tau) => {
+            let k = topology.face_edges[face as usize]
+                .iter()
+                .position(|&e| e == c.edge)
+                .unwrap_or(0);
+            let forward = topology.edges[c.edge as usize][0] == t[k];
+            k as f64 + if forward { tau } else { 1.0 - tau }
+        }
+    }
+}
+
+impl Chord {
+    /// Whether two chords of the same face cross, or come within `gap` of each other's
+    /// ends along the boundary (a shared vertex, or ends that would make a sliver).
+    pub fn crosses_or_touches(&self, other: &Chord, gap: f64) -> bool {
+        let near = |x: f64, y: f64| {
+            let d = (x - y).abs();
+            d.min(3.0 - d) < gap
+        };
+        if self
+            .ends
+            .iter()
+            .any(|&x| other.ends.iter().any(|&y| near(x, y)))
+        {
+            return true;
+        }
+        let (lo, hi) = (
+            self.ends[0].min(self.ends[1]),
+            self.ends[0].max(self.ends[1]),
+        );
+        let inside = |x: f64| lo < x && x < hi;
+        inside(other.ends[0]) != inside(other.ends[1])
+    }
+}
+
+/// Length of the closed polygon `points`.
+pub fn closed_length(points: &[DVec3]) -> f64 {
+    points
+        .iter()
+        .zip(points.iter().cycle().skip(1))
+        .map(|(a, b)| a.distance(*b))
+        .sum()
+}
+
+/// Whether `p` lies inside the closed polygon `points` of the plane with unit `normal`
+/// (even–odd crossing rule in plane coordinates).
+pub fn polygon_contains(points: &[DVec3], normal: DVec3, p: DVec3) -> bool {
+    let (u, w) = normal.any_orthonormal_pair();
+    let planar: Vec<(f64, f64)> = points
+        .iter()
+        .map(|q| ((*q - p).dot(u), (*q - p).dot(w)))
+        .collect();
+    let mut inside = false;
+    for (i, &(x0, y0)) in planar.iter().enumerate() {
+        let (x1, y1) = planar[(i + 1) % planar.len()];
+        if (y0 > 0.0) != (y1 > 0.0) && x0 + (x1 - x0) * (-y0) / (y1 - y0) > 0.0 {
+            inside = !inside;
+        }
+    }
+    inside
+}
+
+/// Largest distance between two of `points` (the curve's approximate diameter D, §3.3):
+/// O(m²) over the m points.
+pub fn diameter(points: &[DVec3]) -> f64 {
+    points
+        .iter()
+        .enumerate()
+        .flat_map(|(i, a)| points[i + 1..].iter().map(move |b| a.distance(*b)))
+        .fold(0.0, f64::max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fixtures::shapes::{icosphere, uv_sphere};
+    use std::f64::consts::PI;
+
+    fn all_faces(mesh: &SurfaceMesh) -> Vec<u32> {
+        (0..mesh.triangle_count() as u32).collect()
+    }
+
+    #[test]
+    fn equator_of_a_sphere_is_one_closed_circle() {
+        let mesh = icosphere(1.0, 4);
+        let topology = Topology::new(&mesh);
+        let snap = vertex_snap_distances(&mesh, &topology, 0.01);
+        let mut domain = SectionDomain::new(&mesh, &topology, &snap, all_faces(&mesh));
+        let plane = Plane {
+            point: DVec3::new(0.0, 0.0, 0.3),
+            normal: DVec3::Z,
+        };
+        let curves = domain.closed_sections(&topology, &plane);
+        assert_eq!(curves.len(), 1);
+        let points = curves[0].positions(&mesh, &topology);
+        let radius = (1.0f64 - 0.09).sqrt();
+        assert!((closed_length(&points) - 2.0 * PI * radius).abs() < 0.02 * radius);
+        assert!((diameter(&points) - 2.0 * radius).abs() < 0.02);
+        assert!(points
+            .iter()
+            .all(|p| plane.signed_distance(*p).abs() < 0.01 * 0.2));
+        assert!(polygon_contains(&points, plane.normal, plane.point));
+        assert!(!polygon_contains(
+            &points,
+            plane.normal,
+            plane.point + DVec3::X
+        ));
+    }
+
+    #[test]
+    fn a_plane_through_vertices_chains_through_them() {
+        // The uv sphere's equator ring lies exactly on z = 0.
+        let mesh = uv_sphere(1.0, 8, 16);
+        let topology = Topology::new(&mesh);
+        let snap = vertex_snap_distances(&mesh, &topology, 0.01);
+        let mut domain = SectionDomain::new(&mesh, &topology, &snap, all_faces(&mesh));
+        let plane = Plane {
+            point: DVec3::ZERO,
+            normal: DVec3::Z,
+        };
+        let curves = domain.closed_sections(&topology, &plane);
+        assert_eq!(curves.len(), 1);
+        let mut vertices: Vec<u32> = curves[0]
+            .crossings
+            .iter()
+            .map(|c| match c.point {
+                CrossingPoint::Vertex(v) => v,
+                CrossingPoint::Interior(t) => panic!("interior crossing at {t}"),
+            })
+            .collect();
+        vertices.dedup();
+        assert_eq!(vertices.len(), 16);
+    }
+
+    #[test]
+    fn a_curve_leaving_the_domain_is_open() {
+        let mesh = icosphere(1.0, 3);
+        let topology = Topology::new(&mesh);
+        let snap = vertex_snap_distances(&mesh, &topology, 0.01);
+        let upper: Vec<u32> = all_faces(&mesh)
+            .into_iter()
+            .filter(|&f| mesh.corners(f as usize).iter().all(|c| c.y > -0.2))
+            .collect();
+        let mut domain = SectionDomain::new(&mesh, &topology, &snap, upper);
+        let plane = Plane {
+            point: DVec3::ZERO,
+            normal: DVec3::Z,
+        };
+        assert!(domain.closed_sections(&topology, &plane).is_empty());
+        let horizontal = Plane {
+            point: DVec3::Y * 0.5,
+            normal: DVec3::Y,
+        };
+        assert_eq!(domain.closed_sections(&topology, &horizontal).len(), 1);
+    }
+
+    #[test]
+    fn chords_cross_when_their_ends_interleave() {
+        let chord = |a: f64, b: f64| Chord {
+            face: 0,
+            ends: [a, b],
+        };
+        let gap = 0.01;
+        // Parallel chords cutting corner 1 off at two depths: no conflict.
+        assert!(!chord(0.5, 1.5).crosses_or_touches(&chord(0.8, 1.2), gap));
+        // Interleaved ends cross.
+        assert!(chord(0.5, 1.5).crosses_or_touches(&chord(1.2, 2.5), gap));
+        // A shared corner (s = 1) or ends closer than the gap touch.
+        assert!(chord(1.0, 2.5).crosses_or_touches(&chord(1.0, 0.5), gap));
+        assert!(chord(0.5, 1.5).crosses_or_touches(&chord(1.505, 2.5), gap));
+        // Ends on either side of s = 0 are close across the wrap.
+        assert!(chord(0.002, 1.5).crosses_or_touches(&chord(2.999, 1.8), gap));
+    }
+}

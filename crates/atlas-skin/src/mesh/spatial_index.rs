@@ -1,0 +1,670 @@
+//! Point and ray queries against a surface, pruned by per-face bounding spheres: nearest
+//! surface distance, faces near a point, first hit along a ray.
+//!
+//! Point queries visit a uniform grid of the sphere centres (about four faces per cell),
+//! ray queries descend a bounding volume hierarchy of the faces' boxes (the faces in
+//! Morton order of their centres, halved recursively: depth ⌈log₂ F⌉ at most); the exact
+//! test runs only on faces whose sphere passes.
+//! The decomposition asks them once per joint, never once per candidate plane.
+
+use super::surface::SurfaceMesh;
+use crate::geometry::point_triangle_distance;
+use crate::rows::Rows;
+use glam::{DVec3, IVec3};
+use rayon::slice::ParallelSliceMut;
+
+/// A bounding sphere per face (centre = centroid, radius = farthest corner from it), and
+/// a grid of the centres.
+#[derive(Debug, Clone, Default)]
+pub struct FaceSpheres {
+    pub centres: Vec<DVec3>,
+    pub radii: Vec<f64>,
+    /// Largest radius.
+    max_radius: f64,
+    grid: CentreGrid,
+    bvh: FaceBvh,
+}
+
+/// Cells of side `cell` from `origin`, `dims` per axis; row k of `faces` lists the faces
+/// whose centre lies in cell k (x fastest).
+#[derive(Debug, Clone, Default)]
+struct CentreGrid {
+    origin: DVec3,
+    cell: f64,
+    dims: IVec3,
+    faces: Rows<u32>,
+}
+
+impl CentreGrid {
+    fn new(centres: &[DVec3]) -> Self {
+        let (lo, hi) = crate::geometry::bounding_box(centres);
+        let extent = (hi - lo).max(DVec3::splat(1e-12));
+        let target_cells = (centres.len() / 4).max(1) as f64;
+        let volume = extent.x.max(extent.length() * 1e-3)
+            * extent.y.max(extent.length() * 1e-3)
+            * extent.z.max(extent.length() * 1e-3);
+        let cell = (volume / target_cells)
+            .cbrt()
+            .max(extent.max_element() / 256.0);
+        let dims = ((extent / cell).floor().as_ivec3() + IVec3::ONE).min(IVec3::splat(257));
+        let mut grid = Self {
+            origin: lo,
+            cell,
+            dims,
+            faces: Rows::default(),
+        };
+        let cells: Vec<usize> = centres
+            .iter()
+            .map(|c| grid.index(grid.cell_of(*c)))
+            .collect();
+        let cell_count = (dims.x * dims.y * dims.z) as usize;
+        grid.faces = Rows::group(
+            cell_count,
+            cells.iter().enumerate().map(|(f, &k)| (k, f as u32)),
+        );
+        grid
+    }
+
+    fn cell_of(&self, p: DVec3) -> IVec3 {
+        ((p - self.origin) / self.cell)
+            .floor()
+            .as_ivec3()
+            .clamp(IVec3::ZERO, self.dims - IVec3::ONE)
+    }
+
+    fn index(&self, c: IVec3) -> usize {
+        (c.x + self.dims.x * (c.y + self.dims.y * c.z)) as usize
+    }
+
+    fn contains(&self, p: DVec3) -> bool {
+        let q = (p - self.origin) / self.cell;
+        q.cmpge(DVec3::ZERO).all() && q.cmplt(self.dims.as_dvec3()).all()
+    }
+
+    /// Faces whose centre lies in a cell of the box `lo..=hi` of cell coordinates, except
+    /// the cells of the box `skip_lo..=skip_hi` (pass an empty box to keep all). Cells
+    /// x-adjacent are adjacent in `faces`, so each row of the box (or each side of the
+    /// skipped box in a row) is one slice.
+    fn faces_in(
+        &self,
+        lo: IVec3,
+        hi: IVec3,
+        skip_lo: IVec3,
+        skip_hi: IVec3,
+    ) -> impl Iterator<Item = u32> + '_ {
+        let (lo, hi) = (lo.max(IVec3::ZERO), hi.min(self.dims - IVec3::ONE));
+        (lo.z..=hi.z)
+            .flat_map(move |z| (lo.y..=hi.y).map(move |y| (y, z)))
+            .flat_map(move |(y, z)| {
+                let skipped = (skip_lo.y..=skip_hi.y).contains(&y)
+                    && (skip_lo.z..=skip_hi.z).contains(&z)
+                    && skip_lo.x <= skip_hi.x;
+                let (left_end, right_start) = if skipped {
+                    (skip_lo.x - 1, skip_hi.x + 1)
+                } else {
+                    (hi.x, hi.x + 1)
+                };
+                [
+                    self.row(y, z, lo.x, left_end.min(hi.x)),
+                    self.row(y, z, right_start.max(lo.x), hi.x),
+                ]
+            })
+            .flatten()
+            .copied()
+    }
+
+    /// Faces of the cells x0..=x1 of row (y, z), empty when x0 > x1.
+    fn row(&self, y: i32, z: i32, x0: i32, x1: i32) -> &[u32] {
+        if x0 > x1 {
+            return &[];
+        }
+        let (k0, k1) = (
+            self.index(IVec3::new(x0, y, z)),
+            self.index(IVec3::new(x1, y, z)),
+        );
+        &self.faces.values[self.faces.offsets[k0] as usize..self.faces.offsets[k1 + 1] as usize]
+    }
+}
+
+/// Sorts distinct face indices below `face_count`: by a bitmap of the faces, O(k + F/64),
+/// when the k indices are at least F/256 of them, else by comparison, O(k log k).
+fn sort_face_indices(faces: &mut [u32], face_count: usize) {
+    if faces.len() * 256 < face_count {
+        faces.sort_unstable();
+        return;
+    }
+    let mut bits = vec![0u64; face_count.div_ceil(64)];
+    for &f in faces.iter() {
+        bits[f as usize / 64] |= 1 << (f % 64);
+    }
+    let sorted = bits.iter().enumerate().flat_map(|(w, &word)| {
+        let mut rest = word;
+        std::iter::from_fn(move || {
+            (rest != 0).then(|| {
+                let bit = rest.trailing_zeros();
+                rest &= rest - 1;
+                (w * 64) as u32 + bit
+            })
+        })
+    });
+    for (slot, f) in faces.iter_mut().zip(sorted) {
+        *slot = f;
+    }
+}
+
+/// The first surface point a ray meets.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RayHit {
+    pub face: u32,
+    /// Distance along the (unit) ray direction.
+    pub distance: f64,
+}
+
+impl FaceSpheres {
+    /// Spheres of every face of `mesh` and their grid, in O(F).
+    pub fn new(mesh: &SurfaceMesh) -> Self {
+        let (centres, radii): (Vec<DVec3>, Vec<f64>) = (0..mesh.triangle_count())
+            .map(|f| {
+                let corners = mesh.corners(f);
+                let centre = (corners[0] + corners[1] + corners[2]) / 3.0;
+                let radius = corners
+                    .iter()
+                    .map(|c| c.distance(centre))
+                    .fold(0.0, f64::max);
+                (centre, radius)
+            })
+            .unzip();
+        let max_radius = radii.iter().copied().fold(0.0, f64::max);
+        let grid = CentreGrid::new(&centres);
+        let bvh = FaceBvh::new(mesh, &centres);
+        Self {
+            centres,
+            radii,
+            max_radius,
+            grid,
+            bvh,
+        }
+    }
+
+    /// Distance from `p` to the nearest point of the surface, `f64::INFINITY` without faces.
+    ///
+    /// Shells of cells around p's cell are visited outwards; |p − c_f| − r_f bounds the
+    /// distance to face f from below, so a face is tested exactly only when that bound is
+    /// below the best distance so far, and the search stops once every centre beyond the
+    /// shell (at least shell · cell away) is too far. A point outside the grid scans all.
+    pub fn nearest_distance(&self, mesh: &SurfaceMesh, p: DVec3) -> f64 {
+        let mut best = f64::INFINITY;
+        let test = |f: u32, best: &mut f64| {
+            let f = f as usize;
+            if self.centres[f].distance(p) - self.radii[f] < *best {
+                let [a, b, c] = mesh.corners(f);
+                *best = best.min(point_triangle_distance(p, a, b, c));
+            }
+        };
+        if self.centres.is_empty() {
+            return best;
+        }
+        if !self.grid.contains(p) {
+            for f in 0..self.centres.len() as u32 {
+                test(f, &mut best);
+            }
+            return best;
+        }
+        let centre = self.grid.cell_of(p);
+        let rings = self.grid.dims.max_element();
+        for ring in 0..=rings {
+            let r = IVec3::splat(ring);
+            // Only the shell: the inner cells were visited by the earlier rings.
+            let inner = IVec3::splat(ring - 1);
+            for f in self
+                .grid
+                .faces_in(centre - r, centre + r, centre - inner, centre + inner)
+            {
+                test(f, &mut best);
+            }
+            if best <= ring as f64 * self.grid.cell - self.max_radius {
+                break;
+            }
+        }
+        best
+    }
+
+    /// Faces whose sphere meets the ball of `radius` around `p` (a superset of the faces
+    /// that meet the ball), in face order.
+    pub fn faces_near(&self, p: DVec3, radius: f64) -> Vec<u32> {
+        if self.centres.is_empty() {
+            return Vec::new();
+        }
+        let reach = DVec3::splat(radius + self.max_radius);
+        let mut faces: Vec<u32> = self
+            .grid
+            .faces_in(
+                self.grid.cell_of(p - reach),
+                self.grid.cell_of(p + reach),
+                IVec3::ONE,
+                IVec3::ZERO,
+            )
+            .filter(|&f| {
+                let f = f as usize;
+                self.centres[f].distance_squared(p) <= (radius + self.radii[f]).powi(2)
+            })
+            .collect();
+        sort_face_indices(&mut faces, self.centres.len());
+        faces
+    }
+
+    /// First face hit by the ray `origin + t · direction`, t > 0, `direction` unit length
+    /// (Möller–Trumbore 1997 on faces whose sphere the ray meets); of faces hit at the same
+    /// t, the lowest index. The hierarchy is descended nearer child first and a node is
+    /// skipped once its box starts beyond the best hit, so a ray costs O(log F) boxes and a
+    /// few triangles where it runs clear of the surface.
+    pub fn first_hit(&self, mesh: &SurfaceMesh, origin: DVec3, direction: DVec3) -> Option<RayHit> {
+        let nodes = &self.bvh.nodes;
+        let mut best: Option<RayHit> = None;
+        if nodes.is_empty() {
+            return best;
+        }
+        let beyond_best =
+            |entry: f64, best: &Option<RayHit>| best.is_some_and(|h| entry > h.distance);
+        let mut stack: Vec<u32> = Vec::with_capacity(64);
+        stack.push(0);
+        while let Some(k) = stack.pop() {
+            let node = &nodes[k as usize];
+            match node.ray_entry(origin, direction) {
+                Some(entry) if !beyond_best(entry, &best) => {}
+                _ => continue,
+            }
+            if node.count > 0 {
+                let (start, end) = (node.start as usize, (node.start + node.count) as usize);
+                for &f in &self.bvh.faces[start..end] {
+                    if let Some(t) = self.sphere_hit(mesh, f as usize, origin, direction) {
+                        if best.is_none_or(|h| t < h.distance || (t == h.distance && f < h.face)) {
+                            best = Some(RayHit {
+                                face: f,
+                                distance: t,
+                            });
+                        }
+                    }
+                }
+                continue;
+            }
+            let (first, second) = (k + 1, k + node.start);
+            let entry = |n: u32| nodes[n as usize].ray_entry(origin, direction);
+            // Pushed last, popped first: the child the ray enters first.
+            if entry(first).unwrap_or(f64::INFINITY) <= entry(second).unwrap_or(f64::INFINITY) {
+                stack.extend([second, first]);
+            } else {
+                stack.extend([first, second]);
+            }
+        }
+        best
+    }
+
+    /// t of the ray's hit on face `f`, tested exactly only when the ray meets its sphere.
+    fn sphere_hit(
+        &self,
+        mesh: &SurfaceMesh,
+        f: usize,
+        origin: DVec3,
+        direction: DVec3,
+    ) -> Option<f64> {
+        let (c, r) = (self.centres[f], self.radii[f]);
+        let to_centre = c - origin;
+        let along = to_centre.dot(direction);
+        if along < -r || (to_centre - direction * along).length_squared() > r * r {
+            return None;
+        }
+        let [a, b, c] = mesh.corners(f);
+        ray_triangle(origin, direction, a, b, c)
+    }
+}
+
+/// Faces at most this many to a leaf of [`FaceBvh`].
+const LEAF_FACES: usize = 4;
+
+/// A bounding volume hierarchy of the faces' boxes, nodes in depth-first order: an inner
+/// node k's first child is k + 1, its second child k + `start`.
+#[derive(Debug, Clone, Default)]
+struct FaceBvh {
+    nodes: Vec<BvhNode>,
+    /// Face indices, each leaf's a contiguous run.
+    faces: Vec<u32>,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct BvhNode {
+    lo: DVec3,
+    hi: DVec3,
+    /// A leaf's first entry of `faces`; an inner node's offset to its second child (the
+    /// first follows it).
+    start: u32,
+    /// A leaf's face count; 0 for an inner node.
+    count: u32,
+}
+
+impl FaceBvh {
+    /// Orders the faces along a Morton (Z-order) curve of their centres, then halves that
+    /// order recursively: O(F log F) for the sort, O(F) for the tree, depth
+    /// ⌈log₂(F / LEAF_FACES)⌉ + 1. Boxes are padded by 1e-9 of the mesh's extent so that a
+    /// hit Möller–Trumbore rounds out of its face's box is still found.
+    fn new(mesh: &SurfaceMesh, centres: &[DVec3]) -> Self {
+        let (lo, hi) = mesh.bounding_box();
+        let pad = DVec3::splat(1e-9 * (hi - lo).max_element().max(f64::MIN_POSITIVE));
+        let boxes: Vec<[DVec3; 2]> = (0..mesh.triangle_count())
+            .map(|f| {
+                let [a, b, c] = mesh.corners(f);
+                [a.min(b).min(c) - pad, a.max(b).max(c) + pad]
+            })
+            .collect();
+        let (centre_lo, centre_hi) = crate::geometry::bounding_box(centres);
+        let scale = MORTON_CELLS / (centre_hi - centre_lo).max(DVec3::splat(f64::MIN_POSITIVE));
+        let mut keyed: Vec<(u64, u32)> = centres
+            .iter()
+            .enumerate()
+            .map(|(f, c)| (morton_code(((*c - centre_lo) * scale).as_uvec3()), f as u32))
+            .collect();
+        keyed.par_sort_unstable();
+        let mut bvh = Self {
+            nodes: Vec::with_capacity(2 * centres.len() / LEAF_FACES + 1),
+            faces: keyed.into_iter().map(|(_, f)| f).collect(),
+        };
+        if !bvh.faces.is_empty() {
+            bvh.build(0..bvh.faces.len(), &boxes);
+        }
+        bvh
+    }
+
+    /// Appends the subtree of the faces `range` of `self.faces`; returns its box.
+    fn build(&mut self, range: std::ops::Range<usize>, boxes: &[[DVec3; 2]]) -> [DVec3; 2] {
+        let index = self.nodes.len();
+        self.nodes.push(BvhNode {
+            lo: DVec3::ZERO,
+            hi: DVec3::ZERO,
+            start: range.start as u32,
+            count: range.len() as u32,
+        });
+        let [lo, hi] = if range.len() <= LEAF_FACES {
+            self.faces[range]
+                .iter()
+                .fold([DVec3::INFINITY, DVec3::NEG_INFINITY], |[lo, hi], &f| {
+                    [lo.min(boxes[f as usize][0]), hi.max(boxes[f as usize][1])]
+                })
+        } else {
+            let middle = range.start + range.len() / 2;
+            let [first_lo, first_hi] = self.build(range.start..middle, boxes);
+            self.nodes[index].start = (self.nodes.len() - index) as u32;
+            self.nodes[index].count = 0;
+            let [second_lo, second_hi] = self.build(middle..range.end, boxes);
+            [first_lo.min(second_lo), first_hi.max(second_hi)]
+        };
+        (self.nodes[index].lo, self.nodes[index].hi) = (lo, hi);
+        [lo, hi]
+    }
+}
+
+/// Cells per axis of the Morton code's grid (21 bits per axis fill 63 bits).
+const MORTON_CELLS: f64 = ((1u32 << 21) - 1) as f64;
+
+/// Interleaves the low 21 bits of x, y, z: bit i of x goes to bit 3i (Morton 1966).
+fn morton_code(cell: glam::UVec3) -> u64 {
+    let spread = |v: u32| {
+        let mut v = u64::from(v.min((1 << 21) - 1));
+        v = (v | v << 32) & 0x001f_0000_0000_ffff;
+        v = (v | v << 16) & 0x001f_0000_ff00_00ff;
+        v = (v | v << 8) & 0x100f_00f0_0f00_f00f;
+        v = (v | v << 4) & 0x10c3_0c30_c30c_30c3;
+        (v | v << 2) & 0x1249_2492_4924_9249
+    };
+    spread(cell.x) | spread(cell.y) << 1 | spread(cell.z) << 2
+}
+
+impl BvhNode {
+    /// Smallest t ≥ 0 at which the ray is in the box (slab test), `None` when it misses.
+    fn ray_entry(&self, origin: DVec3, direction: DVec3) -> Option<f64> {
+        let (mut near, mut far) = (0.0f64, f64::INFINITY);
+        for axis in 0..3 {
+            let (o, d) = (origin[axis], direction[axis]);
+            let (lo, hi) = (self.lo[axis], self.hi[axis]);
+            if d == 0.0 {
+                if o < lo || o > hi {
+                    return None;
+                }
+                continue;
+            }
+            let (t0, t1) = ((lo - o) / d, (hi - o) / d);
+            near = near.max(t0.min(t1));
+            far = far.min(t0.max(t1));
+        }
+        (near <= far).then_some(near)
+    }
+}
+
+/// Möller–Trumbore: t > 0 with origin + t·direction in triangle abc, None when parallel.
+fn ray_triangle(origin: DVec3, direction: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Option<f64> {
+    let (ab, ac) = (b - a, c - a);
+    let p = direction.cross(ac);
+    let det = ab.dot(p);
+    if det.abs() <= 1e-14 * ab.length_squared().max(ac.length_squared()) {
+        return None;
+    }
+    let s = origin - a;
+    let u = s.dot(p) / det;
+    let q = s.cross(ab);
+    let v = direction.dot(q) / det;
+    let t = ac.dot(q) / det;
+    (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0).then_some(t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fixtures::shapes::icosphere;
+
+    #[test]
+    fn point_triangle_distance_in_every_voronoi_region() {
+        let (a, b, c) = (DVec3::ZERO, DVec3::X, DVec3::Y);
+        let cases = [
+            (DVec3::new(0.2, 0.2, 1.0), 1.0),
+            (DVec3::new(-1.0, -1.0, 0.0), 2f64.sqrt()),
+            (DVec3::new(2.0, 0.0, 0.0), 1.0),
+            (DVec3::new(0.5, -1.0, 0.0), 1.0),
+            (DVec3::new(1.0, 1.0, 0.0), 0.5f64.sqrt()),
+            (DVec3::new(-2.0, 0.5, 0.0), 2.0),
+        ];
+        for (p, expected) in cases {
+            let d = point_triangle_distance(p, a, b, c);
+            assert!((d - expected).abs() < 1e-12, "{p}: {d} vs {expected}");
+        }
+        assert!((point_triangle_distance(DVec3::Z, a, a, b) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn sphere_queries_match_the_geometry() {
+        let mesh = icosphere(1.0, 3);
+        let spheres = FaceSpheres::new(&mesh);
+        let inner = spheres.nearest_distance(&mesh, DVec3::new(0.0, 0.0, 0.3));
+        assert!((inner - 0.7).abs() < 0.01, "{inner}");
+        let hit = spheres
+            .first_hit(&mesh, DVec3::ZERO, DVec3::X)
+            .expect("a ray from the centre leaves the sphere");
+        assert!((hit.distance - 1.0).abs() < 0.01);
+        assert!(spheres.first_hit(&mesh, DVec3::X * 2.0, DVec3::X).is_none());
+        let near = spheres.faces_near(DVec3::Z, 0.2);
+        assert!(!near.is_empty() && near.len() < mesh.triangle_count() / 4);
+        assert!(near
+            .iter()
+            .all(|&f| spheres.centres[f as usize].distance(DVec3::Z) < 0.5));
+    }
+
+    /// The reference for [`FaceSpheres::first_hit`]: every face, lowest index on ties.
+    fn first_hit_by_scan(mesh: &SurfaceMesh, origin: DVec3, direction: DVec3) -> Option<RayHit> {
+        (0..mesh.triangle_count())
+            .filter_map(|f| {
+                let [a, b, c] = mesh.corners(f);
+                ray_triangle(origin, direction, a, b, c).map(|t| RayHit {
+                    face: f as u32,
+                    distance: t,
+                })
+            })
+            .min_by(|x, y| x.distance.total_cmp(&y.distance).then(x.face.cmp(&y.face)))
+    }
+
+    #[test]
+    fn hierarchy_ray_hits_match_a_full_scan() {
+        let (mesh, _) = crate::fixtures::shapes::bent_cylinder(0.5, 3.0, 70.0, 24, 12);
+        let spheres = FaceSpheres::new(&mesh);
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let mut hits = 0;
+        for _ in 0..2000 {
+            let origin = DVec3::new(next() * 0.6, next() * 1.5 + 1.5, next() * 0.6);
+            let direction = DVec3::new(next(), next(), next()).normalize_or(DVec3::X);
+            let fast = spheres.first_hit(&mesh, origin, direction);
+            assert_eq!(
+                fast,
+                first_hit_by_scan(&mesh, origin, direction),
+                "{origin} {direction}"
+            );
+            hits += usize::from(fast.is_some());
+        }
+        // Rays along the axes, through vertices and edges of the grid-aligned cylinder.
+        for v in mesh.positions.iter().step_by(7) {
+            for direction in [DVec3::X, DVec3::NEG_Y, DVec3::Z] {
+                let origin = *v - direction;
+                let fast = spheres.first_hit(&mesh, origin, direction);
+                assert_eq!(
+                    fast,
+                    first_hit_by_scan(&mesh, origin, direction),
+                    "{origin}"
+                );
+            }
+        }
+        assert!(hits > 1000, "{hits} rays of 2000 hit");
+    }
+
+    /// Rays from every joint of makehuman's body and cesiumman along its bones and six
+    /// turned axes (the rays the decomposition casts), by the hierarchy and by a full scan.
+    #[test]
+    fn hierarchy_ray_hits_match_a_full_scan_on_the_corpus() {
+        use atlas_skin_io::{load_character, LoadOptions};
+        let models = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/models");
+        let cases = [
+            (
+                "makehuman/base.obj",
+                Some("makehuman/default.mhskel"),
+                Some("body"),
+            ),
+            ("cesiumman/CesiumMan.glb", None, None),
+        ];
+        let turn = glam::DQuat::from_euler(glam::EulerRot::XYZ, 0.1234, 0.2345, 0.3456);
+        for (file, skeleton, group) in cases {
+            let options = LoadOptions {
+                skeleton: skeleton.map(|s| std::path::Path::new(models).join(s)),
+                group: group.map(String::from),
+                ..Default::default()
+            };
+            let character = load_character(&std::path::Path::new(models).join(file), &options)
+                .unwrap_or_else(|e| panic!("the corpus is needed: {file}: {e}"));
+            let welded = crate::mesh::weld(
+                &character.mesh.positions,
+                &character.mesh.triangles,
+                crate::mesh::weld::DEFAULT_WELD_TOLERANCE,
+            );
+            let mesh = welded.mesh;
+            let skeleton = character.skeleton.expect("the model has a skeleton");
+            let joints: Vec<DVec3> = skeleton
+                .bind_positions()
+                .iter()
+                .map(|p| p.as_dvec3())
+                .collect();
+            let spheres = FaceSpheres::new(&mesh);
+            let mut hits = 0;
+            for (j, &p) in joints.iter().enumerate() {
+                let bone = skeleton
+                    .parent(j)
+                    .and_then(|q| (p - joints[q]).try_normalize());
+                let axes = [
+                    DVec3::X,
+                    DVec3::NEG_X,
+                    DVec3::Y,
+                    DVec3::NEG_Y,
+                    DVec3::Z,
+                    DVec3::NEG_Z,
+                ];
+                for direction in axes.into_iter().map(|a| turn * a).chain(bone) {
+                    let fast = spheres.first_hit(&mesh, p, direction);
+                    assert_eq!(
+                        fast,
+                        first_hit_by_scan(&mesh, p, direction),
+                        "{file} joint {j}"
+                    );
+                    hits += usize::from(fast.is_some());
+                }
+            }
+            assert!(hits > joints.len(), "{file}: {hits} hits");
+        }
+    }
+
+    #[test]
+    fn morton_codes_interleave_the_axes() {
+        let code = |x, y, z| morton_code(glam::UVec3::new(x, y, z));
+        assert_eq!(
+            [code(1, 0, 0), code(0, 1, 0), code(0, 0, 1), code(2, 0, 0)],
+            [1, 2, 4, 8]
+        );
+        assert_eq!(code(3, 5, 6), 0b110_101_011);
+        let top = (1 << 21) - 1;
+        assert_eq!(code(top, top, top), (1u64 << 63) - 1);
+    }
+
+    #[test]
+    fn face_indices_sort_by_bitmap_and_by_comparison() {
+        // 100 of 100 000 faces sort by comparison, 4 of 130 by bitmap.
+        for (face_count, step) in [(100_000, 1000), (130, 37)] {
+            let mut faces: Vec<u32> = (0..face_count as u32).rev().step_by(step).collect();
+            let mut expected = faces.clone();
+            expected.sort_unstable();
+            sort_face_indices(&mut faces, face_count);
+            assert_eq!(faces, expected, "{face_count} faces");
+        }
+    }
+
+    #[test]
+    fn grid_nearest_distance_matches_a_full_scan() {
+        let (mesh, _) = crate::fixtures::shapes::bent_cylinder(0.5, 3.0, 70.0, 24, 12);
+        let spheres = FaceSpheres::new(&mesh);
+        let full = |p: DVec3| {
+            (0..mesh.triangle_count())
+                .map(|f| {
+                    let [a, b, c] = mesh.corners(f);
+                    point_triangle_distance(p, a, b, c)
+                })
+                .fold(f64::INFINITY, f64::min)
+        };
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        for _ in 0..200 {
+            let mut next = || {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                (state >> 11) as f64 / (1u64 << 53) as f64
+            };
+            let p = DVec3::new(next() * 5.0 - 1.5, next() * 7.0 - 1.0, next() * 3.0 - 1.5);
+            let (grid, scan) = (spheres.nearest_distance(&mesh, p), full(p));
+            assert!((grid - scan).abs() < 1e-12, "{p}: {grid} vs {scan}");
+            let radius = next();
+            let near: Vec<u32> = (0..mesh.triangle_count() as u32)
+                .filter(|&f| {
+                    let f = f as usize;
+                    spheres.centres[f].distance_squared(p) <= (radius + spheres.radii[f]).powi(2)
+                })
+                .collect();
+            assert_eq!(spheres.faces_near(p, radius), near, "{p} {radius}");
+        }
+    }
+}

@@ -1,0 +1,313 @@
+//! Connectivity of a triangle surface: edges, adjacency, components, boundary, genus.
+
+use super::surface::SurfaceMesh;
+use super::union_find::UnionFind;
+use crate::rows::Rows;
+
+/// Edges and adjacency of a [`SurfaceMesh`], built once and passed to later stages.
+///
+/// Edge `e` joins `edges[e] = [a, b]` with `a < b`. Triangle `f`'s edge `i` joins its corners
+/// `i` and `(i + 1) % 3` and is `face_edges[f][i]`. Compressed rows: the faces around edge `e`
+/// are `edge_faces[edge_face_offsets[e]..edge_face_offsets[e + 1]]` (1 on a boundary, 2 inside
+/// a manifold, more on a non-manifold edge); likewise `vertex_faces` and `vertex_neighbors`.
+#[derive(Debug, Clone, Default)]
+pub struct Topology {
+    pub edges: Vec<[u32; 2]>,
+    pub face_edges: Vec<[u32; 3]>,
+    pub edge_face_offsets: Vec<u32>,
+    pub edge_faces: Vec<u32>,
+    pub vertex_face_offsets: Vec<u32>,
+    pub vertex_faces: Vec<u32>,
+    pub vertex_neighbor_offsets: Vec<u32>,
+    pub vertex_neighbors: Vec<u32>,
+}
+
+impl Topology {
+    /// Builds the topology of `mesh` in O(F log F).
+    pub fn new(mesh: &SurfaceMesh) -> Self {
+        let nv = mesh.vertex_count();
+        let mut half: Vec<(u32, u32, u32, u8)> = Vec::with_capacity(mesh.triangles.len() * 3);
+        for (f, t) in mesh.triangles.iter().enumerate() {
+            for i in 0..3 {
+                let (a, b) = (t[i], t[(i + 1) % 3]);
+                half.push((a.min(b), a.max(b), f as u32, i as u8));
+            }
+        }
+        half.sort_unstable();
+        let mut edges = Vec::new();
+        let mut face_edges = vec![[0u32; 3]; mesh.triangles.len()];
+        let mut edge_face_offsets = vec![0u32];
+        let mut edge_faces = Vec::with_capacity(half.len());
+        for (k, &(a, b, f, i)) in half.iter().enumerate() {
+            if k == 0 || (half[k - 1].0, half[k - 1].1) != (a, b) {
+                if k > 0 {
+                    edge_face_offsets.push(edge_faces.len() as u32);
+                }
+                edges.push([a, b]);
+            }
+            face_edges[f as usize][i as usize] = edges.len() as u32 - 1;
+            edge_faces.push(f);
+        }
+        if !half.is_empty() {
+            edge_face_offsets.push(edge_faces.len() as u32);
+        }
+
+        let (vertex_face_offsets, vertex_faces) = compress(
+            nv,
+            mesh.triangles
+                .iter()
+                .enumerate()
+                .flat_map(|(f, t)| t.iter().map(move |&v| (v, f as u32))),
+        );
+        let (vertex_neighbor_offsets, vertex_neighbors) = compress(
+            nv,
+            edges
+                .iter()
+                .filter(|e| e[0] != e[1])
+                .flat_map(|e| [(e[0], e[1]), (e[1], e[0])]),
+        );
+        Self {
+            edges,
+            face_edges,
+            edge_face_offsets,
+            edge_faces,
+            vertex_face_offsets,
+            vertex_faces,
+            vertex_neighbor_offsets,
+            vertex_neighbors,
+        }
+    }
+
+    /// Faces around edge `e`.
+    pub fn faces_of_edge(&self, e: usize) -> &[u32] {
+        &self.edge_faces[self.edge_face_offsets[e] as usize..self.edge_face_offsets[e + 1] as usize]
+    }
+
+    /// Faces around vertex `v`.
+    pub fn faces_of_vertex(&self, v: usize) -> &[u32] {
+        &self.vertex_faces
+            [self.vertex_face_offsets[v] as usize..self.vertex_face_offsets[v + 1] as usize]
+    }
+
+    /// Vertices joined to `v` by an edge.
+    pub fn neighbors(&self, v: usize) -> &[u32] {
+        &self.vertex_neighbors
+            [self.vertex_neighbor_offsets[v] as usize..self.vertex_neighbor_offsets[v + 1] as usize]
+    }
+
+    /// Faces sharing an edge with face `f` (across manifold and non-manifold edges).
+    pub fn face_neighbors(&self, f: usize) -> impl Iterator<Item = u32> + '_ {
+        self.face_edges[f]
+            .iter()
+            .flat_map(move |&e| self.faces_of_edge(e as usize).iter().copied())
+            .filter(move |&g| g as usize != f)
+    }
+
+    /// Component index of every vertex (vertices joined by triangles), numbered by first
+    /// vertex; vertices no triangle uses get their own component. Returns (#V labels, count).
+    pub fn vertex_components(&self, mesh: &SurfaceMesh) -> (Vec<u32>, usize) {
+        let n = mesh.vertex_count();
+        let mut label = vec![u32::MAX; n];
+        let mut count = 0u32;
+        let mut stack = Vec::new();
+        for start in 0..n {
+            if label[start] != u32::MAX {
+                continue;
+            }
+            label[start] = count;
+            stack.push(start);
+            while let Some(v) = stack.pop() {
+                for &u in self.neighbors(v) {
+                    if label[u as usize] == u32::MAX {
+                        label[u as usize] = count;
+                        stack.push(u as usize);
+                    }
+                }
+            }
+            count += 1;
+        }
+        (label, count as usize)
+    }
+}
+
+/// Groups `(key, value)` pairs into compressed rows over `0..n` keys, values sorted.
+fn compress(n: usize, pairs: impl Iterator<Item = (u32, u32)> + Clone) -> (Vec<u32>, Vec<u32>) {
+    let mut rows = Rows::group(n, pairs.map(|(k, v)| (k as usize, v)));
+    for i in 0..n {
+        rows.values[rows.offsets[i] as usize..rows.offsets[i + 1] as usize].sort_unstable();
+    }
+    (rows.offsets, rows.values)
+}
+
+/// Facts about one connected component.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ComponentStats {
+    pub vertices: usize,
+    pub triangles: usize,
+    pub closed: bool,
+    pub euler: i64,
+    pub boundary_loops: usize,
+    /// g = (2 − χ − b) / 2 for an orientable surface with b boundary loops.
+    pub genus: i64,
+}
+
+/// Facts about a whole surface, as `atlas-skin inspect` reports them.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct MeshStats {
+    pub vertices: usize,
+    pub triangles: usize,
+    pub edges: usize,
+    pub components: usize,
+    /// Every edge has exactly two faces.
+    pub closed: bool,
+    pub boundary_edges: usize,
+    pub boundary_loops: usize,
+    pub nonmanifold_edges: usize,
+    /// Interior edges whose two faces run along them in the same direction.
+    pub inconsistently_oriented_edges: usize,
+    /// Triangles with a repeated vertex or an area below 1e-12 × diagonal².
+    pub degenerate_triangles: usize,
+    /// χ = V − E + F over vertices used by triangles.
+    pub euler_characteristic: i64,
+    /// Σ over components of their genus, when the surface is closed.
+    pub genus: Option<i64>,
+    pub per_component: Vec<ComponentStats>,
+}
+
+impl MeshStats {
+    /// Measures `mesh` with its `topology`.
+    pub fn new(mesh: &SurfaceMesh, topology: &Topology) -> Self {
+        let (label, count) = topology.vertex_components(mesh);
+        let mut per = vec![(0usize, 0usize, 0usize, 0usize); count]; // V, E, F, boundary edges
+        let mut used = vec![false; mesh.vertex_count()];
+        for t in &mesh.triangles {
+            for &v in t {
+                used[v as usize] = true;
+            }
+            per[label[t[0] as usize] as usize].2 += 1;
+        }
+        for (v, &u) in used.iter().enumerate() {
+            if u {
+                per[label[v] as usize].0 += 1;
+            }
+        }
+        let mut boundary_edges = 0;
+        let mut nonmanifold_edges = 0;
+        let mut inconsistent = 0;
+        let mut boundary_sets = UnionFind::new(mesh.vertex_count());
+        let mut boundary_vertex = vec![false; mesh.vertex_count()];
+        for (e, &[a, b]) in topology.edges.iter().enumerate() {
+            let c = label[a as usize] as usize;
+            per[c].1 += 1;
+            let faces = topology.faces_of_edge(e);
+            match faces.len() {
+                1 => {
+                    boundary_edges += 1;
+                    per[c].3 += 1;
+                    boundary_vertex[a as usize] = true;
+                    boundary_vertex[b as usize] = true;
+                    boundary_sets.union(a, b);
+                }
+                2 => {
+                    let forward = |f: u32| {
+                        let t = mesh.triangles[f as usize];
+                        (0..3).any(|i| t[i] == a && t[(i + 1) % 3] == b)
+                    };
+                    if forward(faces[0]) == forward(faces[1]) {
+                        inconsistent += 1;
+                    }
+                }
+                _ => nonmanifold_edges += 1,
+            }
+        }
+        let mut loops_per = vec![0usize; count];
+        for v in 0..mesh.vertex_count() {
+            if boundary_vertex[v] && boundary_sets.find(v as u32) == v as u32 {
+                loops_per[label[v] as usize] += 1;
+            }
+        }
+        let diag2 = mesh.diagonal().powi(2);
+        let degenerate_triangles = (0..mesh.triangle_count())
+            .filter(|&f| {
+                let t = mesh.triangles[f];
+                t[0] == t[1]
+                    || t[1] == t[2]
+                    || t[0] == t[2]
+                    || mesh.triangle_area(f) <= 1e-12 * diag2
+            })
+            .count();
+        let per_component: Vec<ComponentStats> = per
+            .iter()
+            .zip(&loops_per)
+            .filter(|((v, _, f, _), _)| *v > 0 && *f > 0)
+            .map(|(&(v, e, f, b), &loops)| {
+                let euler = v as i64 - e as i64 + f as i64;
+                ComponentStats {
+                    vertices: v,
+                    triangles: f,
+                    closed: b == 0,
+                    euler,
+                    boundary_loops: loops,
+                    genus: (2 - euler - loops as i64) / 2,
+                }
+            })
+            .collect();
+        let closed = boundary_edges == 0 && nonmanifold_edges == 0;
+        let euler_characteristic = per_component.iter().map(|c| c.euler).sum();
+        Self {
+            vertices: used.iter().filter(|&&u| u).count(),
+            triangles: mesh.triangle_count(),
+            edges: topology.edges.len(),
+            components: per_component.len(),
+            closed,
+            boundary_edges,
+            boundary_loops: loops_per.iter().sum(),
+            nonmanifold_edges,
+            inconsistently_oriented_edges: inconsistent,
+            degenerate_triangles,
+            euler_characteristic,
+            genus: closed.then(|| per_component.iter().map(|c| c.genus).sum()),
+            per_component,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    fn tetrahedron() -> SurfaceMesh {
+        SurfaceMesh {
+            positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z],
+            triangles: vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
+        }
+    }
+
+    #[test]
+    fn closed_tetrahedron_is_a_sphere() {
+        let mesh = tetrahedron();
+        let topo = Topology::new(&mesh);
+        let stats = MeshStats::new(&mesh, &topo);
+        assert_eq!(stats.edges, 6);
+        assert!(stats.closed);
+        assert_eq!(stats.euler_characteristic, 2);
+        assert_eq!(stats.genus, Some(0));
+        assert_eq!(stats.inconsistently_oriented_edges, 0);
+        assert_eq!(topo.neighbors(0), &[1, 2, 3]);
+        assert_eq!(topo.face_neighbors(0).count(), 3);
+    }
+
+    #[test]
+    fn open_surface_has_boundary_loop_and_no_genus() {
+        let mut mesh = tetrahedron();
+        mesh.triangles.pop();
+        let stats = MeshStats::new(&mesh, &Topology::new(&mesh));
+        assert!(!stats.closed);
+        assert_eq!(stats.boundary_edges, 3);
+        assert_eq!(stats.boundary_loops, 1);
+        assert_eq!(stats.euler_characteristic, 1);
+        assert_eq!(stats.genus, None);
+        assert_eq!(stats.per_component[0].genus, 0);
+    }
+}

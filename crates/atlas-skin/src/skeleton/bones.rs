@@ -1,0 +1,108 @@
+//! Bones as segments: the segments each joint moves, point-to-segment distances, the
+//! nearest bone of a point, and the rigid binding of every vertex to its nearest bone (the
+//! simplest automatic weights: the fallback of the weights stage and a baseline).
+
+use crate::geometry::point_segment_distance;
+use atlas_skin_runtime::{Skeleton, VertexWeights};
+use glam::DVec3;
+
+/// Bone segments of every joint: joint j moves the segments from j to each of its children;
+/// a leaf j has the segment to its tail when the skeleton gives one ([`Skeleton::tails`]),
+/// and otherwise continues its parent's bone p→j by half its length (j, j + (j − p)/2), so
+/// that what lies beyond an end joint binds to it rather than to the parent; a lone root
+/// without a tail has the point (j, j). Returns (joint, start, end) triples.
+pub fn bone_segments(skeleton: &Skeleton) -> Vec<(u32, DVec3, DVec3)> {
+    let positions: Vec<DVec3> = skeleton
+        .bind_positions()
+        .iter()
+        .map(|p| p.as_dvec3())
+        .collect();
+    let children = skeleton.children();
+    let mut segments = Vec::new();
+    for (j, kids) in children.iter().enumerate() {
+        if kids.is_empty() {
+            let beyond = match skeleton.tails[j] {
+                Some(tail) => tail.as_dvec3(),
+                None => skeleton.parent(j).map_or(positions[j], |p| {
+                    positions[j] + (positions[j] - positions[p]) * 0.5
+                }),
+            };
+            segments.push((j as u32, positions[j], beyond));
+        }
+        for &c in kids {
+            segments.push((j as u32, positions[j], positions[c]));
+        }
+    }
+    segments
+}
+
+/// Bones as (parent, child) joint pairs, skipping those whose two ends coincide.
+///
+/// - `positions`: #J bind positions of `skeleton`'s joints.
+pub fn joint_pairs(skeleton: &Skeleton, positions: &[DVec3]) -> Vec<(usize, usize)> {
+    (0..skeleton.len())
+        .filter_map(|c| skeleton.parent(c).map(|p| (p, c)))
+        .filter(|&(p, c)| positions[p] != positions[c])
+        .collect()
+}
+
+/// The bones of `pairs` ([`joint_pairs`]) with neither end at joint `j`, as segments:
+/// what a cut or a leaf's reach at `j` must keep clear of.
+pub fn bones_not_at(pairs: &[(usize, usize)], positions: &[DVec3], j: usize) -> Vec<[DVec3; 2]> {
+    pairs
+        .iter()
+        .filter(|&&(p, c)| p != j && c != j)
+        .map(|&(p, c)| [positions[p], positions[c]])
+        .collect()
+}
+
+/// Weight 1 on the joint owning the bone segment nearest to each position (Euclidean, not
+/// along the surface: it can bind an arm vertex to a touching thigh).
+///
+/// - `positions`: #V points; returns #V rows of one influence each (none for an empty
+///   skeleton).
+pub fn nearest_bone_weights(positions: &[DVec3], skeleton: &Skeleton) -> VertexWeights {
+    let segments = bone_segments(skeleton);
+    VertexWeights::from_rows(
+        positions
+            .iter()
+            .map(|&p| nearest_bone(&segments, p).map(|j| (j, 1.0))),
+    )
+}
+
+/// The joint owning the bone segment nearest to `p`, argmin_j dist(p, segment_j)
+/// (`segments` from [`bone_segments`]; `None` when there is none).
+pub fn nearest_bone(segments: &[(u32, DVec3, DVec3)], p: DVec3) -> Option<u32> {
+    segments
+        .iter()
+        .map(|&(j, a, b)| (j, point_segment_distance(p, a, b)))
+        .min_by(|x, y| x.1.total_cmp(&y.1))
+        .map(|(j, _)| j)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use atlas_skin_runtime::NO_PARENT;
+    use glam::Vec3;
+
+    #[test]
+    fn vertices_bind_to_the_bone_they_lie_along() {
+        let skeleton = Skeleton::from_positions(
+            vec!["root".into(), "elbow".into(), "tip".into()],
+            vec![NO_PARENT, 0, 1],
+            &[Vec3::ZERO, Vec3::X, Vec3::X * 2.0],
+        )
+        .unwrap();
+        let w = nearest_bone_weights(
+            &[
+                DVec3::new(0.4, 0.1, 0.0),
+                DVec3::new(1.6, -0.1, 0.0),
+                DVec3::new(2.5, 0.0, 0.0),
+            ],
+            &skeleton,
+        );
+        let dominant: Vec<u32> = (0..3).map(|v| w.row(v).next().unwrap().0).collect();
+        assert_eq!(dominant, vec![0, 1, 2]);
+    }
+}
