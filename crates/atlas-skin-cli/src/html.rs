@@ -16,7 +16,20 @@ use std::path::Path;
 
 /// The page around the model; `@@NAME@@` markers are filled by [`fill_template`].
 const TEMPLATE: &str = include_str!("../viewer/viewer.html");
-const VIEWER_JS: &str = include_str!("../viewer/viewer.js");
+/// The viewer's scripts, joined in this order inside one function of the page's script; the
+/// last one starts the viewer.
+const VIEWER_JS: [&str; 10] = [
+    include_str!("../viewer/math.js"),
+    include_str!("../viewer/gltf.js"),
+    include_str!("../viewer/pose.js"),
+    include_str!("../viewer/report.js"),
+    include_str!("../viewer/gpu.js"),
+    include_str!("../viewer/draw.js"),
+    include_str!("../viewer/camera.js"),
+    include_str!("../viewer/controls.js"),
+    include_str!("../viewer/pointer.js"),
+    include_str!("../viewer/viewer.js"),
+];
 const GLSL_SKINNING: &str = include_str!("../viewer/skinning.glsl");
 const GLSL_MESH_VERT: &str = include_str!("../viewer/mesh.vert");
 const GLSL_MESH_FRAG: &str = include_str!("../viewer/mesh.frag");
@@ -56,7 +69,7 @@ pub fn write_html(
             ("GLSL_MESH_FRAG", GLSL_MESH_FRAG),
             ("GLSL_LINE_VERT", GLSL_LINE_VERT),
             ("GLSL_LINE_FRAG", GLSL_LINE_FRAG),
-            ("VIEWER_JS", VIEWER_JS),
+            ("VIEWER_JS", &VIEWER_JS.concat()),
         ],
     )?;
     Ok(atlas_skin_io::write_atomically(out, None, page.as_bytes())?)
@@ -199,14 +212,13 @@ mod tests {
 
     #[test]
     fn embedded_sources_cannot_close_their_script_element() {
-        for source in [
-            VIEWER_JS,
+        for source in VIEWER_JS.into_iter().chain([
             GLSL_SKINNING,
             GLSL_MESH_VERT,
             GLSL_MESH_FRAG,
             GLSL_LINE_VERT,
             GLSL_LINE_FRAG,
-        ] {
+        ]) {
             assert!(!source.to_ascii_lowercase().contains("</script"));
             assert!(
                 !source.contains("@@"),
