@@ -16,7 +16,20 @@ use std::path::Path;
 
 /// The page around the model; `@@NAME@@` markers are filled by [`fill_template`].
 const TEMPLATE: &str = include_str!("../viewer/viewer.html");
-const VIEWER_JS: &str = include_str!("../viewer/viewer.js");
+/// The viewer's scripts, joined in this order inside one function of the page's script; the
+/// last one starts the viewer.
+const VIEWER_JS: [&str; 10] = [
+    include_str!("../viewer/math.js"),
+    include_str!("../viewer/gltf.js"),
+    include_str!("../viewer/pose.js"),
+    include_str!("../viewer/report.js"),
+    include_str!("../viewer/gpu.js"),
+    include_str!("../viewer/draw.js"),
+    include_str!("../viewer/camera.js"),
+    include_str!("../viewer/controls.js"),
+    include_str!("../viewer/pointer.js"),
+    include_str!("../viewer/viewer.js"),
+];
 const GLSL_SKINNING: &str = include_str!("../viewer/skinning.glsl");
 const GLSL_MESH_VERT: &str = include_str!("../viewer/mesh.vert");
 const GLSL_MESH_FRAG: &str = include_str!("../viewer/mesh.frag");
@@ -56,10 +69,28 @@ pub fn write_html(
             ("GLSL_MESH_FRAG", GLSL_MESH_FRAG),
             ("GLSL_LINE_VERT", GLSL_LINE_VERT),
             ("GLSL_LINE_FRAG", GLSL_LINE_FRAG),
-            ("VIEWER_JS", VIEWER_JS),
+            ("VIEWER_JS", &viewer_script()),
         ],
     )?;
     Ok(atlas_skin_io::write_atomically(out, None, page.as_bytes())?)
+}
+
+/// The viewer's scripts joined in order, without their whole-line `//` comments: the sources'
+/// documentation stays out of every report. No line of the scripts lies inside a multi-line
+/// string, where such a line would be text (a test checks their backticks).
+fn viewer_script() -> String {
+    let mut script = String::new();
+    for line in VIEWER_JS.iter().flat_map(|source| source.lines()) {
+        if !is_comment_line(line) {
+            script.push_str(line);
+            script.push('\n');
+        }
+    }
+    script
+}
+
+fn is_comment_line(line: &str) -> bool {
+    line.trim_start().starts_with("//")
 }
 
 /// Checks the 12-byte GLB header: magic, version 2 and a declared length equal to the data's.
@@ -154,8 +185,6 @@ fn escape_html(text: &str) -> String {
     escaped
 }
 
-/// Writes `bytes` to a temporary file in `out`'s folder, then renames it to `out`; on error
-/// the temporary file is removed.
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -199,19 +228,48 @@ mod tests {
 
     #[test]
     fn embedded_sources_cannot_close_their_script_element() {
-        for source in [
-            VIEWER_JS,
+        for source in VIEWER_JS.into_iter().chain([
             GLSL_SKINNING,
             GLSL_MESH_VERT,
             GLSL_MESH_FRAG,
             GLSL_LINE_VERT,
             GLSL_LINE_FRAG,
-        ] {
+        ]) {
             assert!(!source.to_ascii_lowercase().contains("</script"));
             assert!(
                 !source.contains("@@"),
                 "a source contains the template marker"
             );
+        }
+    }
+
+    #[test]
+    fn viewer_script_leaves_out_comment_lines_only() {
+        // A template literal spanning lines would show as a code line with an odd number of
+        // backticks: then a `//` line could be its text, not a comment.
+        for source in VIEWER_JS {
+            for line in source.lines().filter(|line| !is_comment_line(line)) {
+                assert_eq!(
+                    line.matches('`').count() % 2,
+                    0,
+                    "multi-line string at {line:?}"
+                );
+            }
+        }
+        let script = viewer_script();
+        assert!(!script.lines().any(is_comment_line));
+        let sources: usize = VIEWER_JS.iter().map(|source| source.len()).sum();
+        assert!(
+            script.len() < sources * 9 / 10,
+            "few comment lines were left out"
+        );
+        for code in [
+            "const mat4 = {",
+            "function start() {",
+            "  start();",
+            "const POSE_DEAD_ZONE = 8;",
+        ] {
+            assert!(script.contains(code), "{code:?} is missing");
         }
     }
 
