@@ -74,33 +74,14 @@ pub fn decompose(
     let split_topology = Topology::new(&surface);
     let (face_region, region_count) = grow_regions(&surface, &split_topology, &split.loops);
 
-    // Each placed cut takes its loop (in placement order) and its two sides.
-    let mut loops = split.loops.into_iter();
-    let outcomes: Vec<Outcome> = placements
-        .into_iter()
-        .enumerate()
-        .map(|(j, placement)| match placement {
-            Placement::Cut { candidate, frame } => {
-                let curve = loops.next().unwrap_or_default();
-                let plane = &searches[j].candidates[candidate].plane;
-                match side_regions(&surface, &split_topology, &face_region, &curve, plane) {
-                    Some((parent, child)) if parent != child => Outcome::Cut {
-                        candidate,
-                        curve,
-                        parent,
-                        child,
-                        frame,
-                    },
-                    _ => Outcome::Soft {
-                        reason: "its closed cut does not separate the surface".into(),
-                        frame,
-                    },
-                }
-            }
-            Placement::Soft { reason, frame } => Outcome::Soft { reason, frame },
-            Placement::Skip(reason) => Outcome::Skip(reason),
-        })
-        .collect();
+    let outcomes = settle_cuts(
+        placements,
+        &searches,
+        &surface,
+        &split_topology,
+        &face_region,
+        split.loops,
+    );
     let sides = |want_child: bool| -> Vec<Option<u32>> {
         outcomes
             .iter()
@@ -135,6 +116,47 @@ pub fn decompose(
         boundaries,
         joints,
     })
+}
+
+/// The outcome of every joint once the surface is split along the placed cuts: each cut
+/// takes its loop (`loops` holds one per placed cut, in placement order) and the regions
+/// on its two sides; a cut that does not separate the surface becomes a soft boundary.
+fn settle_cuts(
+    placements: Vec<Placement>,
+    searches: &[CutSearch],
+    surface: &SurfaceMesh,
+    topology: &Topology,
+    face_region: &[u32],
+    loops: Vec<Vec<u32>>,
+) -> Vec<Outcome> {
+    let mut loops = loops.into_iter();
+    placements
+        .into_iter()
+        .enumerate()
+        .map(|(j, placement)| match placement {
+            Placement::Cut { candidate, frame } => {
+                let curve = loops.next();
+                debug_assert!(curve.is_some(), "one split loop per placed cut");
+                let curve = curve.unwrap_or_default();
+                let plane = &searches[j].candidates[candidate].plane;
+                match side_regions(surface, topology, face_region, &curve, plane) {
+                    Some((parent, child)) if parent != child => Outcome::Cut {
+                        candidate,
+                        curve,
+                        parent,
+                        child,
+                        frame,
+                    },
+                    _ => Outcome::Soft {
+                        reason: "its closed cut does not separate the surface".into(),
+                        frame,
+                    },
+                }
+            }
+            Placement::Soft { reason, frame } => Outcome::Soft { reason, frame },
+            Placement::Skip(reason) => Outcome::Skip(reason),
+        })
+        .collect()
 }
 
 /// The boundaries and the per-joint decisions, in skeleton order. A cut's plane,

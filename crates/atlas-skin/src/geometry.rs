@@ -1,5 +1,6 @@
 //! Distances and extents of geometric primitives, shared by every stage.
 
+use crate::tolerance::NORMAL_UNDERFLOW;
 use glam::DVec3;
 
 /// Parameter t ∈ [0, 1] of the point of segment `[a, b]` nearest to `p`:
@@ -24,7 +25,7 @@ pub fn point_segment_distance(p: DVec3, a: DVec3, b: DVec3) -> f64 {
 pub fn point_triangle_distance(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
     let (ab, ac, ap) = (b - a, c - a, p - a);
     let normal = ab.cross(ac);
-    if normal.length_squared() <= 1e-300 {
+    if normal.length_squared() <= NORMAL_UNDERFLOW {
         return point_segment_distance(p, a, b)
             .min(point_segment_distance(p, b, c))
             .min(point_segment_distance(p, c, a));

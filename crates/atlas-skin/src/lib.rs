@@ -27,6 +27,7 @@ pub mod regions;
 pub mod report;
 pub mod rows;
 pub mod skeleton;
+pub mod tolerance;
 pub mod weights;
 
 pub use decompose::{decompose, DecomposeError, DecomposeParams};

@@ -4,6 +4,9 @@
 
 use rayon::prelude::*;
 
+/// Rows per parallel work item of [`Rows::par_build`] where the work per row is small.
+pub const PAR_CHUNK: usize = 2048;
+
 /// Rows of values over `0..n`: row i is `values[offsets[i] as usize..offsets[i + 1] as usize]`.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Rows<T> {

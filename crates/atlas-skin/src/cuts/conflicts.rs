@@ -48,18 +48,7 @@ pub fn place_cuts(
     gap: f64,
 ) -> Vec<Placement> {
     let candidates: Vec<&[CutCandidate]> = searches.iter().map(|s| &s.candidates[..]).collect();
-    let on_mirror_plane =
-        |j: usize| matches!(&plans[j], JointPlan::Boundary(frame) if frame.on_mirror_plane);
-    let mut order: Vec<usize> = (0..plans.len())
-        .filter(|&j| matches!(plans[j], JointPlan::Boundary(_)) && !candidates[j].is_empty())
-        .collect();
-    order.sort_by(|&a, &b| {
-        on_mirror_plane(a).cmp(&on_mirror_plane(b)).then(
-            candidates[a][0]
-                .perimeter
-                .total_cmp(&candidates[b][0].perimeter),
-        )
-    });
+    let order = placement_order(plans, &candidates);
     let mut placed_chords: HashMap<u32, Vec<(u32, Chord)>> = HashMap::new();
     let mut vertex_owner: HashMap<u32, u32> = HashMap::new();
     let mut placed: Vec<Option<Result<usize, Vec<u32>>>> = vec![None; plans.len()];
@@ -99,45 +88,72 @@ pub fn place_cuts(
         .iter()
         .zip(placed)
         .zip(searches)
-        .map(|((plan, placed), search)| {
-            let frame = match plan {
-                JointPlan::Skip(reason) | JointPlan::Exclude(reason) => {
-                    return Placement::Skip(reason.clone())
-                }
-                JointPlan::Soft(frame, reason) => {
-                    return Placement::Soft {
-                        reason: reason.clone(),
-                        frame: *frame,
-                    }
-                }
-                JointPlan::Boundary(frame) => *frame,
-            };
-            let reason = match placed {
-                Some(Ok(candidate)) => return Placement::Cut { candidate, frame },
-                Some(Err(mut blockers)) => {
-                    blockers.sort_unstable();
-                    blockers.dedup();
-                    let names: Vec<&str> = blockers
-                        .iter()
-                        .map(|&b| skeleton.names[b as usize].as_str())
-                        .collect();
-                    format!(
-                        "every closed section found crosses or touches the cut of {}",
-                        names.join(", ")
-                    )
-                }
-                None if search.enclosing_other_bones > 0 => format!(
-                    "each of the {} closed sections around the joint also encloses another bone \
-                     (a plane across a palm, a foot or the torso)",
-                    search.enclosing_other_bones
-                ),
-                None => "no closed cross-section around the joint near it (open surface, \
-                         joint outside, or a section reaching far from the joint)"
-                    .into(),
-            };
-            Placement::Soft { reason, frame }
-        })
+        .map(|((plan, placed), search)| placement_of(plan, placed, search, skeleton))
         .collect()
+}
+
+/// The joints that search a cut, in the order of the module documentation: by increasing
+/// best perimeter, branching joints on the mirror plane last.
+fn placement_order(plans: &[JointPlan], candidates: &[&[CutCandidate]]) -> Vec<usize> {
+    let on_mirror_plane =
+        |j: usize| matches!(&plans[j], JointPlan::Boundary(frame) if frame.on_mirror_plane);
+    let mut order: Vec<usize> = (0..plans.len())
+        .filter(|&j| matches!(plans[j], JointPlan::Boundary(_)) && !candidates[j].is_empty())
+        .collect();
+    order.sort_by(|&a, &b| {
+        on_mirror_plane(a).cmp(&on_mirror_plane(b)).then(
+            candidates[a][0]
+                .perimeter
+                .total_cmp(&candidates[b][0].perimeter),
+        )
+    });
+    order
+}
+
+/// The placement of one joint: its plan, and for a joint that searched a cut, the accepted
+/// candidate or the joints whose cuts blocked every candidate (`None`: it had none).
+fn placement_of(
+    plan: &JointPlan,
+    placed: Option<Result<usize, Vec<u32>>>,
+    search: &CutSearch,
+    skeleton: &Skeleton,
+) -> Placement {
+    let frame = match plan {
+        JointPlan::Skip(reason) | JointPlan::Exclude(reason) => {
+            return Placement::Skip(reason.clone())
+        }
+        JointPlan::Soft(frame, reason) => {
+            return Placement::Soft {
+                reason: reason.clone(),
+                frame: *frame,
+            }
+        }
+        JointPlan::Boundary(frame) => *frame,
+    };
+    let reason = match placed {
+        Some(Ok(candidate)) => return Placement::Cut { candidate, frame },
+        Some(Err(mut blockers)) => {
+            blockers.sort_unstable();
+            blockers.dedup();
+            let names: Vec<&str> = blockers
+                .iter()
+                .map(|&b| skeleton.names[b as usize].as_str())
+                .collect();
+            format!(
+                "every closed section found crosses or touches the cut of {}",
+                names.join(", ")
+            )
+        }
+        None if search.enclosing_other_bones > 0 => format!(
+            "each of the {} closed sections around the joint also encloses another bone \
+             (a plane across a palm, a foot or the torso)",
+            search.enclosing_other_bones
+        ),
+        None => "no closed cross-section around the joint near it (open surface, \
+                 joint outside, or a section reaching far from the joint)"
+            .into(),
+    };
+    Placement::Soft { reason, frame }
 }
 
 /// The surface vertices a curve runs through.

@@ -16,19 +16,14 @@
 //!    chest, head, jaw). The paper gives it no boundary; here (METHOD.md, "extensions") it
 //!    gets one when it owns a part of the trunk. Nearer to the surface than a quarter of its
 //!    shortest bone (a jaw or tongue root in the mouth) it lies at the skin, not in a trunk:
-//!    no boundary. (Measured on makehuman: the weights stage keeps a soft boundary on the
-//!    part nearest its own bones, so the jaw's own weight no longer bleeds and `--force
-//!    jaw` changes nothing measurable; but a second branching joint at the same point,
-//!    whose bones run forward to the upper lip, takes the lip the artist leaves to the
-//!    head: bleeding .020 → .026 without this rule.) Otherwise where its branches start is
-//!    judged against its section's diameter D = 2 × surface distance. Most child bones (the
-//!    median) shorter than D: it sits at the junction (a chest between shoulders and neck),
-//!    its children's boundaries enclose most of it, so no cut fits; but the trunk below them
-//!    bends with it, as artists weight it: a soft boundary only (its branches take their
-//!    parts from the whole chain below it, see [`crate::weights`]; measured on cesiumman,
-//!    weight L1 .212 → .181, and on riggedfigure .552 → .434, against no boundary). Some
-//!    child bone shorter than D: any plane through it slices that branch's root: a soft
-//!    boundary only. Otherwise its cut is searched like any other but placed after all
+//!    no boundary (docs/measurements.md says what this rule and the next are worth).
+//!    Otherwise where its branches start is judged against its section's diameter
+//!    D = 2 × surface distance. Most child bones (the median) shorter than D: it sits at
+//!    the junction (a chest between shoulders and neck), its children's boundaries enclose
+//!    most of it, so no cut fits; but the trunk below them bends with it, as artists weight
+//!    it: a soft boundary only (its branches take their parts from the whole chain below
+//!    it, see [`crate::weights`]). Some child bone shorter than D: any plane through it
+//!    slices that branch's root: a soft boundary only. Otherwise its cut is searched like any other but placed after all
 //!    others ([`JointFrame::on_mirror_plane`]), and it is soft when no clean cut fits.
 //!    Off the plane (a clavicle with a breast bone, a wrist with five finger bones) a
 //!    branching joint is cut like a chain joint whose lower bone is the mean of its unit
@@ -55,6 +50,7 @@ use crate::geometry::point_segment_distance;
 use crate::mesh::spatial_index::FaceSpheres;
 use crate::mesh::SurfaceMesh;
 use crate::skeleton::bones::{bones_not_at, joint_pairs};
+use crate::tolerance::NEGLIGIBLE;
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -125,9 +121,6 @@ const PAST_COSINE: f64 = 0.5;
 /// part of the body past it.
 const INTERIOR_RADIUS: f64 = 0.1;
 
-/// Bones shorter than this fraction of the skeleton's diagonal have no direction.
-const ZERO_BONE: f64 = 1e-9;
-
 /// Decides, for every joint of `skeleton` (bind positions `positions`), whether it gets a
 /// boundary; `overrides` has one entry per joint.
 pub fn plan_joints(
@@ -138,123 +131,186 @@ pub fn plan_joints(
     overrides: &[Option<Override>],
     params: &DecomposeParams,
 ) -> Vec<JointPlan> {
-    let children = skeleton.children();
-    let scale = diagonal(positions).max(f64::MIN_POSITIVE);
-    let symmetry = infer_symmetry_plane(skeleton, positions, params.symmetry_tolerance);
-    let orientation = orientation_sign(mesh);
-    let bones = joint_pairs(skeleton, positions);
+    let rig = Rig {
+        mesh,
+        spheres,
+        skeleton,
+        positions,
+        children: skeleton.children(),
+        scale: diagonal(positions).max(f64::MIN_POSITIVE),
+        symmetry: infer_symmetry_plane(skeleton, positions, params.symmetry_tolerance),
+        orientation: orientation_sign(mesh),
+        bones: joint_pairs(skeleton, positions),
+        params,
+    };
     (0..skeleton.len())
         .into_par_iter()
-        .map(|j| {
-            let forced = overrides[j] == Some(Override::Force);
-            if overrides[j] == Some(Override::Forbid) {
-                return JointPlan::Exclude("forbidden by the user".into());
+        .map(|j| rig.plan(j, overrides[j]))
+        .collect()
+}
+
+/// What every joint's rules read: the surface, the skeleton and facts derived from both.
+struct Rig<'a> {
+    mesh: &'a SurfaceMesh,
+    spheres: &'a FaceSpheres,
+    skeleton: &'a Skeleton,
+    positions: &'a [DVec3],
+    children: Vec<Vec<usize>>,
+    /// Diagonal of the joints' bounding box.
+    scale: f64,
+    symmetry: Option<SymmetryPlane>,
+    /// [`orientation_sign`] of the surface.
+    orientation: f64,
+    /// [`joint_pairs`] of the skeleton.
+    bones: Vec<(usize, usize)>,
+    params: &'a DecomposeParams,
+}
+
+/// A joint's frame with the vectors of its non-zero child bones and its longest bone.
+struct Bones {
+    frame: JointFrame,
+    child_vectors: Vec<DVec3>,
+    longest_bone: f64,
+}
+
+impl Rig<'_> {
+    /// The rules of the module documentation, in order, for joint `j`.
+    fn plan(&self, j: usize, user: Option<Override>) -> JointPlan {
+        let forced = user == Some(Override::Force);
+        if user == Some(Override::Forbid) {
+            return JointPlan::Exclude("forbidden by the user".into());
+        }
+        if self.skeleton.parent(j).is_none() && !forced {
+            return JointPlan::Skip("root joint: no upper bone to cut".into());
+        }
+        let Some(bones) = self.bones_at(j) else {
+            return JointPlan::Skip("zero-length bones: no direction to cut across".into());
+        };
+        let frame = bones.frame;
+        if forced {
+            return JointPlan::Boundary(frame);
+        }
+        let surface_distance = frame.surface_distance;
+        if surface_distance > self.params.outside_ratio * bones.longest_bone
+            && !is_inside_by_rays(self.mesh, self.spheres, frame.position, self.orientation)
+        {
+            return JointPlan::Exclude(format!(
+                "outside the mesh, owns no geometry: nearest surface {surface_distance:.4} \
+                 away, longest bone {:.4}",
+                bones.longest_bone
+            ));
+        }
+        if frame.on_mirror_plane {
+            if let Some(plan) = branching_plan(&frame, &bones.child_vectors) {
+                return plan;
             }
-            let p = positions[j];
-            let parent = skeleton.parent(j);
-            if parent.is_none() && !forced {
-                return JointPlan::Skip("root joint: no upper bone to cut".into());
+        }
+        if self.children[j].is_empty() {
+            let owns = leaf_owns_geometry(
+                self.mesh,
+                self.spheres,
+                &frame,
+                &bones_not_at(&self.bones, self.positions, j),
+                self.orientation,
+                self.params.leaf_extent_ratio,
+            );
+            if !owns {
+                return JointPlan::Skip(
+                    "end site: the surface does not run on past the joint".into(),
+                );
             }
-            let upper_vector = parent.map_or(DVec3::ZERO, |q| p - positions[q]);
-            let child_vectors: Vec<DVec3> = children[j]
-                .iter()
-                .map(|&c| positions[c] - p)
-                .filter(|v| v.length() > ZERO_BONE * scale)
-                .collect();
-            let lower_mean: DVec3 = child_vectors.iter().map(|v| v.normalize()).sum();
-            let upper = if upper_vector.length() > ZERO_BONE * scale {
-                upper_vector.normalize()
-            } else {
-                lower_mean.normalize_or_zero()
-            };
-            let lower = lower_mean.try_normalize().unwrap_or(upper);
-            if upper == DVec3::ZERO {
-                return JointPlan::Skip("zero-length bones: no direction to cut across".into());
-            }
-            let bone_length = std::iter::once(upper_vector.length())
-                .chain(child_vectors.iter().map(|v| v.length()))
-                .filter(|&l| l > ZERO_BONE * scale)
-                .fold(f64::INFINITY, f64::min);
-            let longest_bone = std::iter::once(upper_vector.length())
-                .chain(child_vectors.iter().map(|v| v.length()))
-                .fold(0.0, f64::max);
-            let surface_distance = spheres.nearest_distance(mesh, p);
-            let on_mirror_plane = child_vectors.len() >= 2
-                && symmetry.is_some_and(|plane| {
-                    (plane.normal.dot(p) - plane.offset).abs()
-                        <= ON_PLANE * params.symmetry_tolerance * scale
-                });
-            let frame = JointFrame {
+        }
+        JointPlan::Boundary(frame)
+    }
+
+    /// The frame of joint `j` (rules 1–3): upper and lower directions, bone lengths, the
+    /// surface distance and whether it branches on the mirror plane; `None` when all its
+    /// bones have zero length.
+    fn bones_at(&self, j: usize) -> Option<Bones> {
+        let (positions, scale) = (self.positions, self.scale);
+        let p = positions[j];
+        let upper_vector = self
+            .skeleton
+            .parent(j)
+            .map_or(DVec3::ZERO, |q| p - positions[q]);
+        let child_vectors: Vec<DVec3> = self.children[j]
+            .iter()
+            .map(|&c| positions[c] - p)
+            .filter(|v| v.length() > NEGLIGIBLE * scale)
+            .collect();
+        let lower_mean: DVec3 = child_vectors.iter().map(|v| v.normalize()).sum();
+        let upper = if upper_vector.length() > NEGLIGIBLE * scale {
+            upper_vector.normalize()
+        } else {
+            lower_mean.normalize_or_zero()
+        };
+        let lower = lower_mean.try_normalize().unwrap_or(upper);
+        if upper == DVec3::ZERO {
+            return None;
+        }
+        let bone_length = std::iter::once(upper_vector.length())
+            .chain(child_vectors.iter().map(|v| v.length()))
+            .filter(|&l| l > NEGLIGIBLE * scale)
+            .fold(f64::INFINITY, f64::min);
+        let longest_bone = std::iter::once(upper_vector.length())
+            .chain(child_vectors.iter().map(|v| v.length()))
+            .fold(0.0, f64::max);
+        let on_mirror_plane = child_vectors.len() >= 2
+            && self.symmetry.is_some_and(|plane| {
+                (plane.normal.dot(p) - plane.offset).abs()
+                    <= ON_PLANE * self.params.symmetry_tolerance * scale
+            });
+        Some(Bones {
+            frame: JointFrame {
                 on_mirror_plane,
                 position: p,
                 upper,
                 lower,
                 bone_length,
-                surface_distance,
-            };
-            if forced {
-                return JointPlan::Boundary(frame);
-            }
-            if surface_distance > params.outside_ratio * longest_bone
-                && !is_inside_by_rays(mesh, spheres, p, orientation)
-            {
-                return JointPlan::Exclude(format!(
-                    "outside the mesh, owns no geometry: nearest surface {surface_distance:.4} \
-                     away, longest bone {longest_bone:.4}"
-                ));
-            }
-            if on_mirror_plane {
-                let mut child_lengths: Vec<f64> =
-                    child_vectors.iter().map(|v| v.length()).collect();
-                child_lengths.sort_unstable_by(f64::total_cmp);
-                let section_diameter = 2.0 * surface_distance;
-                if surface_distance < TRUNK_DEPTH * bone_length {
-                    return JointPlan::Skip(format!(
-                        "branching joint on the mirror plane near the skin, not in a trunk: \
-                         surface {surface_distance:.4} away, shortest bone {bone_length:.4}"
-                    ));
-                }
-                if child_lengths[child_lengths.len() / 2] < section_diameter {
-                    return JointPlan::Soft(
-                        frame,
-                        format!(
-                            "branching joint on the mirror plane at the junction of its branches: \
-                         most of them start within its cross-section (median child bone \
-                         {:.4}, section diameter about {section_diameter:.4}): no cut fits",
-                            child_lengths[child_lengths.len() / 2]
-                        ),
-                    );
-                }
-                if child_lengths[0] < section_diameter {
-                    return JointPlan::Soft(
-                        frame,
-                        format!(
-                            "branching joint on the mirror plane with a branch starting within \
-                             its cross-section (child bone {:.4}, section diameter about \
-                             {section_diameter:.4}): a plane there would cut across it",
-                            child_lengths[0]
-                        ),
-                    );
-                }
-            }
-            if children[j].is_empty() {
-                let owns = leaf_owns_geometry(
-                    mesh,
-                    spheres,
-                    &frame,
-                    &bones_not_at(&bones, positions, j),
-                    orientation,
-                    params.leaf_extent_ratio,
-                );
-                if !owns {
-                    return JointPlan::Skip(
-                        "end site: the surface does not run on past the joint".into(),
-                    );
-                }
-            }
-            JointPlan::Boundary(frame)
+                surface_distance: self.spheres.nearest_distance(self.mesh, p),
+            },
+            child_vectors,
+            longest_bone,
         })
-        .collect()
+    }
+}
+
+/// Rule 4 for a branching joint on the mirror plane: no boundary near the skin, a soft one
+/// where its branches start within its cross-section, `None` (a cut) otherwise.
+fn branching_plan(frame: &JointFrame, child_vectors: &[DVec3]) -> Option<JointPlan> {
+    let (surface_distance, bone_length) = (frame.surface_distance, frame.bone_length);
+    let mut child_lengths: Vec<f64> = child_vectors.iter().map(|v| v.length()).collect();
+    child_lengths.sort_unstable_by(f64::total_cmp);
+    let section_diameter = 2.0 * surface_distance;
+    if surface_distance < TRUNK_DEPTH * bone_length {
+        return Some(JointPlan::Skip(format!(
+            "branching joint on the mirror plane near the skin, not in a trunk: \
+             surface {surface_distance:.4} away, shortest bone {bone_length:.4}"
+        )));
+    }
+    let median = child_lengths[child_lengths.len() / 2];
+    if median < section_diameter {
+        return Some(JointPlan::Soft(
+            *frame,
+            format!(
+                "branching joint on the mirror plane at the junction of its branches: \
+                 most of them start within its cross-section (median child bone \
+                 {median:.4}, section diameter about {section_diameter:.4}): no cut fits"
+            ),
+        ));
+    }
+    if child_lengths[0] < section_diameter {
+        return Some(JointPlan::Soft(
+            *frame,
+            format!(
+                "branching joint on the mirror plane with a branch starting within \
+                 its cross-section (child bone {:.4}, section diameter about \
+                 {section_diameter:.4}): a plane there would cut across it",
+                child_lengths[0]
+            ),
+        ));
+    }
+    None
 }
 
 /// Rule 5: whether the leaf of `frame` owns geometry. `other_bones`: the bones not at the
@@ -349,7 +405,7 @@ fn is_inside_by_rays(
 /// volume Σ a · (b × c) / 6 is negligible (open strips): ray hits are then not filtered.
 fn orientation_sign(mesh: &SurfaceMesh) -> f64 {
     let volume = mesh.signed_volume();
-    if volume.abs() <= 1e-9 * mesh.diagonal().powi(3) {
+    if volume.abs() <= NEGLIGIBLE * mesh.diagonal().powi(3) {
         0.0
     } else {
         volume.signum()

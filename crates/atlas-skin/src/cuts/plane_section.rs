@@ -305,12 +305,20 @@ impl SectionCurve {
 fn boundary_position(mesh: &SurfaceMesh, topology: &Topology, face: u32, c: EdgeCrossing) -> f64 {
     let t = mesh.triangles[face as usize];
     match c.point {
-        CrossingPoint::Vertex(v) => t.iter().position(|&w| w == v).unwrap_or(0) as f64,
+        CrossingPoint::Vertex(v) => {
+            let corner = t.iter().position(|&w| w == v);
+            debug_assert!(
+                corner.is_some(),
+                "a crossing vertex is a corner of its face"
+            );
+            corner.unwrap_or(0) as f64
+        }
         CrossingPoint::Interior(tau) => {
             let k = topology.face_edges[face as usize]
                 .iter()
-                .position(|&e| e == c.edge)
-                .unwrap_or(0);
+                .position(|&e| e == c.edge);
+            debug_assert!(k.is_some(), "a crossing edge is an edge of its face");
+            let k = k.unwrap_or(0);
             let forward = topology.edges[c.edge as usize][0] == t[k];
             k as f64 + if forward { tau } else { 1.0 - tau }
         }

@@ -12,6 +12,7 @@
 
 use crate::cuts::plane_section::{CrossingPoint, SectionCurve};
 use crate::mesh::{SurfaceMesh, Topology};
+use crate::tolerance::FLAT;
 use std::collections::HashMap;
 
 /// The surface with the curves inserted.
@@ -152,7 +153,7 @@ fn fan(piece: &[u32], positions: &mut Vec<glam::DVec3>, triangles: &mut Vec<[u32
         );
         (pb - pa).cross(pc - pa).length()
     };
-    let flat = 1e-12 * scale;
+    let flat = FLAT * scale;
     for apex in 0..n {
         let fan_ok = (1..n - 1).all(|k| {
             area2(

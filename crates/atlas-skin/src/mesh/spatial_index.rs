@@ -10,6 +10,7 @@
 use super::surface::SurfaceMesh;
 use crate::geometry::point_triangle_distance;
 use crate::rows::Rows;
+use crate::tolerance::RAY_PARALLEL;
 use glam::{DVec3, IVec3};
 use rayon::slice::ParallelSliceMut;
 
@@ -444,7 +445,7 @@ fn ray_triangle(origin: DVec3, direction: DVec3, a: DVec3, b: DVec3, c: DVec3) -
     let (ab, ac) = (b - a, c - a);
     let p = direction.cross(ac);
     let det = ab.dot(p);
-    if det.abs() <= 1e-14 * ab.length_squared().max(ac.length_squared()) {
+    if det.abs() <= RAY_PARALLEL * ab.length_squared().max(ac.length_squared()) {
         return None;
     }
     let s = origin - a;

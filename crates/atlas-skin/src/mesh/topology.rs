@@ -3,6 +3,10 @@
 use super::surface::SurfaceMesh;
 use super::union_find::UnionFind;
 use crate::rows::Rows;
+use crate::tolerance::FLAT;
+
+/// A vertex not yet given a component by [`Topology::vertex_components`].
+const UNLABELLED: u32 = u32::MAX;
 
 /// Edges and adjacency of a [`SurfaceMesh`], built once and passed to later stages.
 ///
@@ -107,18 +111,18 @@ impl Topology {
     /// vertex; vertices no triangle uses get their own component. Returns (#V labels, count).
     pub fn vertex_components(&self, mesh: &SurfaceMesh) -> (Vec<u32>, usize) {
         let n = mesh.vertex_count();
-        let mut label = vec![u32::MAX; n];
+        let mut label = vec![UNLABELLED; n];
         let mut count = 0u32;
         let mut stack = Vec::new();
         for start in 0..n {
-            if label[start] != u32::MAX {
+            if label[start] != UNLABELLED {
                 continue;
             }
             label[start] = count;
             stack.push(start);
             while let Some(v) = stack.pop() {
                 for &u in self.neighbors(v) {
-                    if label[u as usize] == u32::MAX {
+                    if label[u as usize] == UNLABELLED {
                         label[u as usize] = count;
                         stack.push(u as usize);
                     }
@@ -191,51 +195,14 @@ impl MeshStats {
                 per[label[v] as usize].0 += 1;
             }
         }
-        let mut boundary_edges = 0;
-        let mut nonmanifold_edges = 0;
-        let mut inconsistent = 0;
-        let mut boundary_sets = UnionFind::new(mesh.vertex_count());
-        let mut boundary_vertex = vec![false; mesh.vertex_count()];
-        for (e, &[a, b]) in topology.edges.iter().enumerate() {
-            let c = label[a as usize] as usize;
-            per[c].1 += 1;
-            let faces = topology.faces_of_edge(e);
-            match faces.len() {
-                1 => {
-                    boundary_edges += 1;
-                    per[c].3 += 1;
-                    boundary_vertex[a as usize] = true;
-                    boundary_vertex[b as usize] = true;
-                    boundary_sets.union(a, b);
-                }
-                2 => {
-                    let forward = |f: u32| {
-                        let t = mesh.triangles[f as usize];
-                        (0..3).any(|i| t[i] == a && t[(i + 1) % 3] == b)
-                    };
-                    if forward(faces[0]) == forward(faces[1]) {
-                        inconsistent += 1;
-                    }
-                }
-                _ => nonmanifold_edges += 1,
-            }
-        }
-        let mut loops_per = vec![0usize; count];
-        for v in 0..mesh.vertex_count() {
-            if boundary_vertex[v] && boundary_sets.find(v as u32) == v as u32 {
-                loops_per[label[v] as usize] += 1;
-            }
-        }
-        let diag2 = mesh.diagonal().powi(2);
-        let degenerate_triangles = (0..mesh.triangle_count())
-            .filter(|&f| {
-                let t = mesh.triangles[f];
-                t[0] == t[1]
-                    || t[1] == t[2]
-                    || t[0] == t[2]
-                    || mesh.triangle_area(f) <= 1e-12 * diag2
-            })
-            .count();
+        let edges = edge_census(mesh, topology, &label, &mut per);
+        let (boundary_edges, nonmanifold_edges, inconsistent, loops_per) = (
+            edges.boundary,
+            edges.nonmanifold,
+            edges.inconsistently_oriented,
+            edges.loops_per_component,
+        );
+        let degenerate_triangles = degenerate_triangles(mesh);
         let per_component: Vec<ComponentStats> = per
             .iter()
             .zip(&loops_per)
@@ -270,6 +237,80 @@ impl MeshStats {
             per_component,
         }
     }
+}
+
+/// Edges of a surface by kind, for [`MeshStats`].
+struct EdgeCensus {
+    boundary: usize,
+    nonmanifold: usize,
+    inconsistently_oriented: usize,
+    /// Boundary loops of every component.
+    loops_per_component: Vec<usize>,
+}
+
+/// Counts boundary (one face), non-manifold (three or more) and inconsistently oriented
+/// (two faces running the edge the same way) edges and the boundary loops per component;
+/// adds every edge, and every boundary edge, to its component's entry of `per`
+/// ((V, E, F, boundary edges) per component of `label`).
+fn edge_census(
+    mesh: &SurfaceMesh,
+    topology: &Topology,
+    label: &[u32],
+    per: &mut [(usize, usize, usize, usize)],
+) -> EdgeCensus {
+    let mut boundary_edges = 0;
+    let mut nonmanifold_edges = 0;
+    let mut inconsistent = 0;
+    let mut boundary_sets = UnionFind::new(mesh.vertex_count());
+    let mut boundary_vertex = vec![false; mesh.vertex_count()];
+    for (e, &[a, b]) in topology.edges.iter().enumerate() {
+        let c = label[a as usize] as usize;
+        per[c].1 += 1;
+        let faces = topology.faces_of_edge(e);
+        match faces.len() {
+            1 => {
+                boundary_edges += 1;
+                per[c].3 += 1;
+                boundary_vertex[a as usize] = true;
+                boundary_vertex[b as usize] = true;
+                boundary_sets.union(a, b);
+            }
+            2 => {
+                let forward = |f: u32| {
+                    let t = mesh.triangles[f as usize];
+                    (0..3).any(|i| t[i] == a && t[(i + 1) % 3] == b)
+                };
+                if forward(faces[0]) == forward(faces[1]) {
+                    inconsistent += 1;
+                }
+            }
+            _ => nonmanifold_edges += 1,
+        }
+    }
+    let mut loops_per = vec![0usize; per.len()];
+    for v in 0..mesh.vertex_count() {
+        if boundary_vertex[v] && boundary_sets.find(v as u32) == v as u32 {
+            loops_per[label[v] as usize] += 1;
+        }
+    }
+    EdgeCensus {
+        boundary: boundary_edges,
+        nonmanifold: nonmanifold_edges,
+        inconsistently_oriented: inconsistent,
+        loops_per_component: loops_per,
+    }
+}
+
+/// Triangles with a repeated corner or an area of at most [`FLAT`] times the squared
+/// diagonal.
+fn degenerate_triangles(mesh: &SurfaceMesh) -> usize {
+    let diag2 = mesh.diagonal().powi(2);
+    (0..mesh.triangle_count())
+        .filter(|&f| {
+            let t = mesh.triangles[f];
+            t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || mesh.triangle_area(f) <= FLAT * diag2
+        })
+        .count()
 }
 
 #[cfg(test)]

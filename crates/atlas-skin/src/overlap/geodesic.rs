@@ -26,6 +26,7 @@
 
 use crate::mesh::edge_distance::Nearest;
 use crate::mesh::{SurfaceMesh, Topology};
+use crate::tolerance::FLAT;
 use glam::DVec3;
 use std::collections::BinaryHeap;
 
@@ -257,7 +258,7 @@ fn unfold(hinge: [DVec3; 2], c: DVec3, flat_hinge: [DVec3; 2], x: DVec3) -> DVec
 fn planar_update(ea: DVec3, eb: DVec3, ta: f64, tb: f64) -> f64 {
     let (aa, ab, bb) = (ea.dot(ea), ea.dot(eb), eb.dot(eb));
     let det = aa * bb - ab * ab;
-    if det <= 1e-12 * aa * bb {
+    if det <= FLAT * aa * bb {
         return f64::INFINITY;
     }
     // P = Q⁻¹ = [[bb, −ab], [−ab, aa]] / det.

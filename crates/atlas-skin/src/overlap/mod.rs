@@ -12,6 +12,10 @@
 //! Distances are computed up to w exactly, with no margin: a vertex farther than w from a
 //! curve weighs the same as one the band never reaches ([`crate::weights`]: its normalised
 //! depth is ≥ 1 inside the region and ≤ 0 outside).
+//!
+//! Inputs: a [`Decomposition`], the decomposed skeleton (for per-joint factors by name),
+//! [`OverlapParams`]. Output: [`Overlaps`]: one half-width per boundary and, per cut, the
+//! band of surface distances ([`geodesic`]).
 
 pub mod geodesic;
 

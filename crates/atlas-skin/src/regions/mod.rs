@@ -11,12 +11,19 @@
 //! joints are listed bound joint first — the cut joint whose child region it is, else its
 //! joint nearest the root — then the others in the skeleton's topological order (along the
 //! chain, parents before children).
+//!
+//! Inputs: the split surface ([`crate::cuts::split`]) and its topology, the cut loops, the
+//! skeleton. Outputs: the region of every face, the regions on each side of every cut, the
+//! region of every joint and the joints each region holds ([`Region`]).
 
 use crate::cuts::plane_section::Plane;
 use crate::decomposition::Region;
 use crate::mesh::{SurfaceMesh, Topology};
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
+
+/// A face not yet grown into a region.
+const NO_REGION: u32 = u32::MAX;
 
 /// Face regions: #F region index of every face and the number of regions; regions are
 /// numbered in the order of their first face.
@@ -34,11 +41,11 @@ pub fn grow_regions(
             }
         }
     }
-    let mut region = vec![u32::MAX; mesh.triangle_count()];
+    let mut region = vec![NO_REGION; mesh.triangle_count()];
     let mut count = 0u32;
     let mut stack = Vec::new();
     for seed in 0..mesh.triangle_count() {
-        if region[seed] != u32::MAX {
+        if region[seed] != NO_REGION {
             continue;
         }
         region[seed] = count;
@@ -49,7 +56,7 @@ pub fn grow_regions(
                     continue;
                 }
                 for &g in topology.faces_of_edge(e as usize) {
-                    if region[g as usize] == u32::MAX {
+                    if region[g as usize] == NO_REGION {
                         region[g as usize] = count;
                         stack.push(g as usize);
                     }

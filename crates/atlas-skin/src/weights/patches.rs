@@ -19,9 +19,8 @@
 //! nearest to the tail through vertices with p_j > 0. A leaf without a stated tail (a
 //! glTF `HeadTop_End`) never has a patch: its bone has no known extent.
 //!
-//! Measured on makehuman (the one corpus rig with such bones; `scripts/quality`): deform
-//! mean .0051 → .0041 and max .084 → .075 with this step; the factor 3 is fitted there
-//! (2: mean .0044, max .083; 2.5: .0042, .076; 3.5: .0044, .075).
+//! The radius factor [`RADIUS_PER_SPACING`] was fitted on makehuman, the one corpus rig with
+//! such bones (docs/measurements.md).
 
 use crate::decomposition::Decomposition;
 use crate::mesh::Topology;

@@ -1,0 +1,167 @@
+//! Step 3 of the weights, the child sides of the soft boundaries (METHOD.md
+//! "extensions"): how far, along the surface, each soft joint's plane moves its region
+//! (module documentation of [`crate::weights`]).
+
+use super::blend::beta;
+use super::ownership::Ownership;
+use crate::decomposition::{Boundary, BoundaryKind, Decomposition};
+use crate::overlap::Overlaps;
+use crate::rows::Rows;
+use crate::skeleton::bones::bone_segments;
+use atlas_skin_runtime::Skeleton;
+use glam::DVec3;
+use rayon::prelude::*;
+use std::collections::VecDeque;
+
+/// A soft boundary, ready for step 3.
+pub struct SoftSide {
+    pub joint: u32,
+    pub region: u32,
+    point: DVec3,
+    normal: DVec3,
+    half_width: f64,
+    /// Bit v set when vertex v is on the child side reached along the surface.
+    reached: Vec<u64>,
+    /// (κ_c, π_c) of every reached vertex, by increasing vertex.
+    ownership: Vec<(u32, f64, f64)>,
+}
+
+impl SoftSide {
+    /// s_c(p) of the module documentation.
+    pub fn share(&self, v: usize, position: DVec3) -> f64 {
+        if self.reached[v / 64] & (1 << (v % 64)) == 0 {
+            return 0.0;
+        }
+        let (kappa, beyond) = self
+            .ownership
+            .binary_search_by_key(&(v as u32), |&(u, _, _)| u)
+            .map_or((0.0, 0.0), |i| (self.ownership[i].1, self.ownership[i].2));
+        let signed = self.normal.dot(position - self.point);
+        let w = self.half_width.max(f64::MIN_POSITIVE);
+        beta(((w + signed) / (2.0 * w)).clamp(0.0, 1.0)).max(beyond) * kappa
+    }
+}
+
+/// Step 3's child sides: for each soft boundary, a flood along edges from the vertices of
+/// the joint's cross-section (within the band |n·(p − o)| ≤ w and within max(D, w) of the
+/// joint), through vertices related to the boundary's region whose signed plane distance
+/// exceeds −w and where κ > 0 ([`Ownership`]). A soft boundary with no
+/// cross-section (diameter 0, or no band vertex near the joint where κ > 0: face bones in
+/// a mouth cavity or an eye socket) is inactive: its joint gets no weight and its region's
+/// other joints keep it.
+pub fn soft_sides(
+    decomposition: &Decomposition,
+    skeleton: &Skeleton,
+    overlaps: &Overlaps,
+    related: &Rows<(u32, f64)>,
+    region_vertices: &[Vec<u32>],
+) -> Vec<SoftSide> {
+    let d = decomposition;
+    let segments = bone_segments(skeleton);
+    // Joints with a boundary of their own (a cut, or a soft boundary with a section): π_c
+    // leaves their bones, and the bones below them, to them.
+    let mut handled = vec![false; skeleton.len()];
+    for b in &d.boundaries {
+        if b.kind != BoundaryKind::Soft || b.diameter > 0.0 {
+            handled[b.joint as usize] = true;
+        }
+    }
+    d.boundaries
+        .par_iter()
+        .enumerate()
+        .filter(|(_, b)| b.kind == BoundaryKind::Soft && b.diameter > 0.0)
+        .filter_map(|(k, b)| {
+            let half_width = overlaps.half_widths[k];
+            let owner = Ownership::new(
+                skeleton,
+                &d.joints,
+                &segments,
+                b.joint as usize,
+                b.parent_region,
+                half_width,
+            );
+            let beyond = owner.beyond(skeleton, &segments, b.joint as usize, &handled);
+            let in_region = |v: usize| related.row(v).iter().any(|&(r, _)| r == b.parent_region);
+            child_side(
+                d,
+                b,
+                half_width,
+                &owner,
+                &beyond,
+                in_region,
+                &region_vertices[b.parent_region as usize],
+            )
+        })
+        .collect()
+}
+
+/// The child side of the soft boundary `b` (half-width `half_width`, κ from `owner`, π from
+/// `beyond`): the flood of [`soft_sides`] from the vertices of `region_seeds` (those its
+/// region reaches) near the joint, through vertices where `in_region` holds; `None` when no
+/// seed qualifies (an inactive boundary).
+fn child_side(
+    d: &Decomposition,
+    b: &Boundary,
+    half_width: f64,
+    owner: &Ownership,
+    beyond: &Ownership,
+    in_region: impl Fn(usize) -> bool,
+    region_seeds: &[u32],
+) -> Option<SoftSide> {
+    let positions = &d.surface.positions;
+    let vertex_count = d.surface.vertex_count();
+    let signed = |v: usize| b.normal.dot(positions[v] - b.point);
+    // Every vertex is examined once: κ depends on the vertex alone.
+    let words = vertex_count.div_ceil(64);
+    let (mut examined, mut reached) = (vec![0u64; words], vec![0u64; words]);
+    let mut ownership = Vec::new();
+    let mut queue = VecDeque::new();
+    let mut visit = |v: u32, queue: &mut VecDeque<u32>| {
+        let (word, bit) = (v as usize / 64, 1u64 << (v % 64));
+        if examined[word] & bit != 0 {
+            return;
+        }
+        examined[word] |= bit;
+        if !in_region(v as usize) {
+            return;
+        }
+        let p = positions[v as usize];
+        let side = signed(v as usize);
+        // π_c matters only where the plane's own term is below 1.
+        let past = if side < half_width { beyond.at(p) } else { 0.0 };
+        if side <= -half_width && past <= 0.0 {
+            return;
+        }
+        let kappa = owner.at(p);
+        if kappa > 0.0 {
+            reached[word] |= bit;
+            ownership.push((v, kappa, past));
+            queue.push_back(v);
+        }
+    };
+    let seed_radius = b.diameter.max(half_width);
+    for &v in region_seeds {
+        let p = positions[v as usize];
+        if p.distance(b.point) <= seed_radius && signed(v as usize) <= half_width {
+            visit(v, &mut queue);
+        }
+    }
+    if queue.is_empty() {
+        return None;
+    }
+    while let Some(v) = queue.pop_front() {
+        for &u in d.topology.neighbors(v as usize) {
+            visit(u, &mut queue);
+        }
+    }
+    ownership.sort_unstable_by_key(|&(v, _, _)| v);
+    Some(SoftSide {
+        joint: b.joint,
+        region: b.parent_region,
+        point: b.point,
+        normal: b.normal,
+        half_width,
+        reached,
+        ownership,
+    })
+}

@@ -1,0 +1,53 @@
+//! The weights stage's result before un-welding: weights of every vertex of the split
+//! surface, and what could not be done as planned.
+
+use serde::Serialize;
+
+/// Weights of every vertex of the split surface, in compressed rows like
+/// [`VertexWeights`]: vertex v's (joint, weight) pairs are at `offsets[v]..offsets[v + 1]`,
+/// weights positive and summing to 1, joints distinct.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SurfaceWeights {
+    pub offsets: Vec<u32>,
+    pub joints: Vec<u32>,
+    pub weights: Vec<f64>,
+}
+
+impl SurfaceWeights {
+    /// Number of vertices.
+    pub fn vertex_count(&self) -> usize {
+        self.offsets.len().saturating_sub(1)
+    }
+
+    /// The (joint, weight) pairs of vertex `v`.
+    pub fn row(&self, v: usize) -> impl Iterator<Item = (u32, f64)> + '_ {
+        let range = self.offsets[v] as usize..self.offsets[v + 1] as usize;
+        self.joints[range.clone()]
+            .iter()
+            .copied()
+            .zip(self.weights[range].iter().copied())
+    }
+
+    pub(crate) fn extend_row(&mut self, row: impl IntoIterator<Item = (u32, f64)>) {
+        for (j, w) in row {
+            self.joints.push(j);
+            self.weights.push(w);
+        }
+        self.offsets.push(self.joints.len() as u32);
+    }
+}
+
+/// What the weights stage could not do as planned, for the report.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+pub struct WeightCounts {
+    /// Surface vertices no region with joints reaches.
+    pub unreachable: usize,
+    /// Of those, vertices weighted from the nearest weighted vertex along the surface.
+    pub from_surface: usize,
+    /// Of those, vertices bound to the nearest bone (no weighted vertex in their component).
+    pub from_bone: usize,
+    /// Joints whose soft boundary is inactive (no cross-section near the joint).
+    pub inactive_soft_joints: Vec<u32>,
+    /// Leaf joints that move a patch of skin (step 3b).
+    pub leaf_patches: Vec<u32>,
+}
