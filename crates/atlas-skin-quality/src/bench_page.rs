@@ -69,14 +69,16 @@ pub fn render(
          random poses come from our own seeded generator, not the one behind BASELINES.md, \
          so *deform* compares samples of the same distribution (on small characters the mean \
          over 10 poses moves by tens of percent with the seed). `eval` also measures DQS and \
-         {} animation frames where a file has an animation; those are in the JSON, not in \
-         these tables.\n",
+         {} animation frames where a file has an animation, and lists each character's {} \
+         worst vertices with both weight rows (`--worst`); those are in the JSON, not in these \
+         tables.\n",
         s.poses,
         s.first_seed,
         s.first_seed + s.poses as u64 - 1,
         s.max_angle_degrees,
         s.bleeding_radius * 100.0,
-        s.anim_frames
+        s.anim_frames,
+        crate::bench_run::WORST_VERTICES
     );
     let bench_results = run.of(Set::Bench);
     if !bench_results.is_empty() {
@@ -270,7 +272,9 @@ fn skin_report(
         out,
         "- vertices weighted by a fallback (`counts.fallback_weighted_vertices` of the \
          `--report` JSON over its `counts.vertices`): {} on average per character, {} of {} \
-         vertices overall ({}); {} of {} characters have some (goal: 0 on every character)",
+         vertices overall ({}); {} of {} characters have some (goal: 0 on every character). \
+         The count is of welded surface vertices (coincident vertices count once) plus stored \
+         vertices no triangle uses, over the stored vertices, as issue 12 counts it",
         percent(average(&shares).unwrap_or(0.0)),
         fallback,
         vertices,

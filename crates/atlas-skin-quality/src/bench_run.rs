@@ -16,6 +16,10 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::time::Instant;
 
+/// How many of each character's worst vertices (`eval --worst`, with both weight rows) the
+/// JSON keeps: where to look first when a character gets worse.
+pub const WORST_VERTICES: usize = 3;
+
 /// The settings `atlas-skin eval` ran with (its defaults).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Settings {
@@ -236,6 +240,7 @@ fn score(exe: &Path, character: &Character, work: &Path) -> Staged<Scored> {
         &character.reference_args,
         &candidate,
         character.prune_reference,
+        WORST_VERTICES,
     )
     .map_err(|e| ("eval", e))?;
     Ok(Scored {
@@ -425,6 +430,7 @@ pub(crate) mod tests {
         for result in &results {
             let s = result.scored().unwrap_or_else(|| panic!("{result:?}"));
             assert_eq!(s.evaluation.matched, s.evaluation.vertices);
+            assert_eq!(s.evaluation.worst_vertices.len(), WORST_VERTICES);
             assert!(s.evaluation.deform_random.mean > 0.0);
             assert!(s.skin.vertices > 0 && s.skin.weights_seconds.is_some());
             let artist = s.skin.reference_single_joint_share.unwrap();

@@ -114,6 +114,7 @@ fn run_eval(exe: &Path, model: &Model, models_dir: &Path, candidate: &Path) -> R
         &model.input_args_in(models_dir, true),
         candidate,
         model.prune_reference,
+        0,
     )
 }
 
