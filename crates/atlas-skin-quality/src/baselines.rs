@@ -1,6 +1,7 @@
 //! The other tools' rows of `shared/data/BASELINES.md`.
 
-use anyhow::{bail, Result};
+use crate::bench_baselines::{BaselineTable, CharacterBaselines, Figures};
+use anyhow::{bail, Context, Result};
 
 /// Cells of the baseline table, in order: model, verts, joints, tool, time s, L1 mean,
 /// L1 p95, dom., deform mean, deform max, anim mean, anim max, bleed.
@@ -91,6 +92,52 @@ pub fn parse_baselines(text: &str) -> Result<Vec<BaselineRow>> {
     Ok(rows)
 }
 
+/// The rows as a [`BaselineTable`] (one character per model, tools in the order they first
+/// appear), so the corpus is scored like the benchmark characters. A model a tool has no
+/// row for counts as a failure of that tool.
+pub fn table(rows: &[BaselineRow]) -> Result<BaselineTable> {
+    let mut table = BaselineTable {
+        tools: Vec::new(),
+        characters: Vec::new(),
+    };
+    for row in rows {
+        if !table.tools.contains(&row.tool) {
+            table.tools.push(row.tool.clone());
+        }
+        if table.character(&row.model).is_none() {
+            table.characters.push(CharacterBaselines {
+                name: row.model.clone(),
+                vertices: row.cells[1].parse().ok(),
+                joints: row.cells[2].parse().ok(),
+                pieces: None,
+                tools: Vec::new(),
+            });
+        }
+    }
+    for character in &mut table.characters {
+        for tool in &table.tools {
+            let row = rows
+                .iter()
+                .find(|r| r.model == character.name && &r.tool == tool);
+            character.tools.push(match row {
+                None => None,
+                Some(row) => Some(Figures {
+                    deform_mean: row.deform_mean,
+                    deform_max: row.deform_max,
+                    l1_mean: row.cells[5].parse().with_context(|| {
+                        format!(
+                            "BASELINES.md, {} {}: L1 mean {:?}",
+                            row.model, tool, row.cells[5]
+                        )
+                    })?,
+                    bleed: row.bleed,
+                }),
+            });
+        }
+    }
+    Ok(table)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -114,6 +161,22 @@ mod tests {
         assert_eq!(rows[1].model, "makehuman");
         assert_eq!(rows[1].cells[10], "—");
         assert_eq!(rows[1].bleed, Some(0.014));
+    }
+
+    #[test]
+    fn rows_become_a_table_of_characters() {
+        let table = table(&parse_baselines(SAMPLE).unwrap()).unwrap();
+        assert_eq!(table.tools, ["heat", "bbw"]);
+        let names: Vec<&str> = table.characters.iter().map(|c| c.name.as_str()).collect();
+        assert_eq!(names, ["cesiumman", "makehuman"]);
+        let cesiumman = &table.characters[0];
+        assert_eq!(
+            (cesiumman.vertices, cesiumman.joints),
+            (Some(3273), Some(19))
+        );
+        assert_eq!(cesiumman.tools[0].unwrap().l1_mean, 0.337);
+        assert_eq!(cesiumman.tools[1], None);
+        assert_eq!(table.characters[1].tools[1].unwrap().deform_max, 0.076);
     }
 
     #[test]

@@ -2,20 +2,16 @@
 //! judges the result with `atlas-skin eval`, and writes docs/quality.md beside the other
 //! tools' rows of `shared/data/BASELINES.md`. Run it through `scripts/quality`.
 
-mod baselines;
 mod table;
 
 use anyhow::{bail, Context, Result};
 use atlas_skin_corpus::{Model, Reference, MODELS};
 use atlas_skin_eval::Evaluation;
+use atlas_skin_quality::{baselines, run};
 use clap::Parser;
-use std::ffi::OsString;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::time::Instant;
 use table::Measured;
-
-const WORKSPACE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
 
 /// Regenerates docs/quality.md from the corpus.
 #[derive(Parser, Debug)]
@@ -46,7 +42,7 @@ fn main() -> Result<()> {
         &std::fs::read_to_string(&baselines_path)
             .with_context(|| format!("cannot read {}", baselines_path.display()))?,
     )?;
-    let exe = atlas_skin_exe()?;
+    let exe = run::atlas_skin_exe()?;
     std::fs::create_dir_all(&args.work)
         .with_context(|| format!("cannot create {}", args.work.display()))?;
     let weighted = || MODELS.iter().filter(|m| m.reference != Reference::None);
@@ -92,41 +88,8 @@ fn main() -> Result<()> {
     Ok(())
 }
 
-/// The `atlas-skin` binary built beside this one.
-fn atlas_skin_exe() -> Result<PathBuf> {
-    let exe = std::env::current_exe()?
-        .with_file_name(format!("atlas-skin{}", std::env::consts::EXE_SUFFIX));
-    if !exe.is_file() {
-        bail!(
-            "{} not found: build it first (cargo build --release -p atlas-skin-cli, or run \
-             scripts/quality from {WORKSPACE})",
-            exe.display()
-        );
-    }
-    Ok(exe)
-}
-
-/// Runs `atlas-skin ARGS`, returning its standard output or an error with its stderr.
-fn atlas_skin(exe: &Path, args: &[OsString]) -> Result<Vec<u8>> {
-    let output = Command::new(exe)
-        .args(args)
-        .output()
-        .with_context(|| format!("cannot run {}", exe.display()))?;
-    if !output.status.success() {
-        bail!(
-            "atlas-skin {} failed: {}",
-            args.iter()
-                .map(|a| a.to_string_lossy())
-                .collect::<Vec<_>>()
-                .join(" "),
-            String::from_utf8_lossy(&output.stderr).trim()
-        );
-    }
-    Ok(output.stdout)
-}
-
 /// `atlas-skin skin MODEL -o CANDIDATE --report R`: returns the weight computation time
-/// from the report (its stages but writing, when it has `timings_ms`) and the wall time.
+/// from the report and the wall time.
 fn run_skin(
     exe: &Path,
     model: &Model,
@@ -134,43 +97,25 @@ fn run_skin(
     candidate: &Path,
     work: &Path,
 ) -> Result<(Option<f64>, f64)> {
-    let report_path = work.join(format!("{}.report.json", model.name));
-    let mut args: Vec<OsString> = vec!["skin".into()];
-    args.extend(model.input_args_in(models_dir, false));
-    args.extend([
-        "-o".into(),
-        candidate.into(),
-        "--report".into(),
-        report_path.clone().into(),
-    ]);
-    let start = Instant::now();
-    atlas_skin(exe, &args)?;
-    let wall = start.elapsed().as_secs_f64();
-    let report: serde_json::Value = serde_json::from_slice(
-        &std::fs::read(&report_path)
-            .with_context(|| format!("cannot read {}", report_path.display()))?,
-    )
-    .with_context(|| format!("{} is not JSON", report_path.display()))?;
-    let weights_ms = report["timings_ms"].as_object().map(|stages| {
-        stages
-            .iter()
-            .filter(|(stage, _)| stage.as_str() != "write")
-            .filter_map(|(_, ms)| ms.as_f64())
-            .sum::<f64>()
-    });
-    Ok((weights_ms.map(|ms| ms / 1000.0), wall))
+    let report = work.join(format!("{}.report.json", model.name));
+    let run = run::run_skin(
+        exe,
+        &model.input_args_in(models_dir, false),
+        candidate,
+        &report,
+    )?;
+    Ok((run.weights_seconds, run.wall_seconds))
 }
 
 /// `atlas-skin eval MODEL CANDIDATE --json`.
 fn run_eval(exe: &Path, model: &Model, models_dir: &Path, candidate: &Path) -> Result<Evaluation> {
-    let mut args: Vec<OsString> = vec!["eval".into()];
-    args.extend(model.input_args_in(models_dir, true));
-    args.extend([candidate.into(), "--json".into()]);
-    if let Some(n) = model.prune_reference {
-        args.extend(["--prune-reference".into(), n.to_string().into()]);
-    }
-    let stdout = atlas_skin(exe, &args)?;
-    serde_json::from_slice(&stdout).context("atlas-skin eval --json printed unexpected JSON")
+    run::run_eval(
+        exe,
+        &model.input_args_in(models_dir, true),
+        candidate,
+        model.prune_reference,
+        0,
+    )
 }
 
 /// Writes the model's own reference weights as a skinned glb (the self-check candidate),

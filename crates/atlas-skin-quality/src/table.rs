@@ -1,8 +1,8 @@
 //! docs/quality.md: our figures beside the baseline rows, and the headline counts.
 
-use crate::baselines::BaselineRow;
 use atlas_skin_corpus::{Model, Reference};
 use atlas_skin_eval::{DeformError, Evaluation};
+use atlas_skin_quality::baselines::{self, BaselineRow};
 use std::fmt::Write;
 
 /// The tool every figure is held to (issue 5's goal).
@@ -163,7 +163,7 @@ pub fn render(measured: &[Measured], baselines: &[BaselineRow], candidate: &str)
         "| model | verts | joints | tool | time s | L1 mean | L1 p95 | dom. | deform mean | \
          deform max | anim mean | anim max | bleed |"
     );
-    let _ = writeln!(out, "|{}", "---|".repeat(crate::baselines::COLUMNS));
+    let _ = writeln!(out, "|{}", "---|".repeat(baselines::COLUMNS));
     for m in measured {
         let _ = writeln!(out, "{}", our_row(m, candidate));
         for row in baselines.iter().filter(|r| r.model == m.model.name) {
@@ -245,9 +245,9 @@ fn seconds(s: Option<f64>) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::baselines::parse_baselines;
     use atlas_skin_corpus::MODELS;
     use atlas_skin_eval::{Bleeding, Validity, WeightsL1};
+    use atlas_skin_quality::baselines::parse_baselines;
 
     fn evaluation(mean: f64, max: f64, bleed: f64) -> Evaluation {
         Evaluation {

@@ -1,0 +1,460 @@
+//! One benchmark run: every character skinned by `atlas-skin skin --report` and judged by
+//! `atlas-skin eval --json` against the weights its file came with, in parallel; a
+//! character that fails gives a result saying why. The whole run serialises to JSON, the
+//! input of `--compare`.
+
+use crate::bench_baselines::{BaselineTable, Figures};
+use crate::bench_characters::{Character, Set};
+use crate::gltf_skins::skinned_meshes;
+use crate::run::{run_eval, run_skin, SkinRun};
+use crate::scoring::Pair;
+use crate::single_joint::single_joint_share;
+use anyhow::{Context, Result};
+use atlas_skin_eval::{EvalOptions, Evaluation};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+use std::time::Instant;
+
+/// How many of each character's worst vertices (`eval --worst`, with both weight rows) the
+/// JSON keeps: where to look first when a character gets worse.
+pub const WORST_VERTICES: usize = 3;
+
+/// The settings `atlas-skin eval` ran with (its defaults).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Settings {
+    pub poses: usize,
+    pub first_seed: u64,
+    pub max_angle_degrees: f64,
+    pub anim_frames: usize,
+    pub bleeding_radius: f64,
+}
+
+impl Settings {
+    /// `eval`'s defaults, which the benchmark does not override.
+    pub fn of_eval() -> Self {
+        let o = EvalOptions::default();
+        Self {
+            poses: o.poses,
+            first_seed: o.seed,
+            max_angle_degrees: f64::from(o.max_angle.to_degrees()).round(),
+            anim_frames: o.anim_frames,
+            bleeding_radius: o.bleeding_radius,
+        }
+    }
+}
+
+/// A whole run, as written to benchmark.json.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BenchmarkRun {
+    /// `git describe`-like: the commit measured, `+changes` when the tree was not clean.
+    pub commit: String,
+    pub settings: Settings,
+    pub jobs: usize,
+    /// Wall time of all characters (skin and eval), seconds.
+    pub wall_seconds: f64,
+    /// The machine's 1-minute load average when the run started and ended (Linux's
+    /// /proc/loadavg), for reading the times: other work on the cores slows them.
+    pub load_average: Option<(f64, f64)>,
+    pub characters: Vec<CharacterResult>,
+}
+
+impl BenchmarkRun {
+    /// The result of `name` in `set`.
+    pub fn find(&self, set: Set, name: &str) -> Option<&CharacterResult> {
+        self.characters
+            .iter()
+            .find(|c| c.set == set && c.name == name)
+    }
+
+    /// The results of `set`, in run order.
+    pub fn of(&self, set: Set) -> Vec<&CharacterResult> {
+        self.characters.iter().filter(|c| c.set == set).collect()
+    }
+
+    /// The characters of `set` that have a row in `table`, with our figures, in the
+    /// table's order.
+    pub fn pairs<'a>(&self, set: Set, table: &'a BaselineTable) -> Vec<Pair<'a>> {
+        table
+            .characters
+            .iter()
+            .filter_map(|baselines| {
+                let ours = self.find(set, &baselines.name)?;
+                Some(Pair {
+                    baselines,
+                    ours: ours.figures(),
+                })
+            })
+            .collect()
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CharacterResult {
+    pub set: Set,
+    pub name: String,
+    /// As the manifest says; `None` where none tells.
+    pub rigid_by_artist: Option<bool>,
+    pub outcome: Outcome,
+}
+
+impl CharacterResult {
+    /// Our figures in the form of the baseline tables; `None` when the character failed.
+    pub fn figures(&self) -> Option<Figures> {
+        match &self.outcome {
+            Outcome::Scored(s) => Some(figures_of(&s.evaluation)),
+            Outcome::Failed { .. } => None,
+        }
+    }
+
+    pub fn scored(&self) -> Option<&Scored> {
+        match &self.outcome {
+            Outcome::Scored(s) => Some(s),
+            Outcome::Failed { .. } => None,
+        }
+    }
+}
+
+/// The table figures of an evaluation: LBS random-pose deformation, weight L1, bleeding.
+pub fn figures_of(e: &Evaluation) -> Figures {
+    Figures {
+        deform_mean: e.deform_random.mean,
+        deform_max: e.deform_random.max,
+        l1_mean: e.weights_l1.mean,
+        bleed: Some(e.bleeding.fraction),
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "status", rename_all = "lowercase")]
+pub enum Outcome {
+    Scored(Box<Scored>),
+    /// `stage`: `skin` or `eval`; `reason`: the error.
+    Failed {
+        stage: String,
+        reason: String,
+    },
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Scored {
+    pub evaluation: Evaluation,
+    pub skin: SkinFacts,
+    /// Wall time of `eval`, seconds.
+    pub eval_seconds: f64,
+}
+
+/// What the `skin` report and the skinned file say.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SkinFacts {
+    /// Stored vertices of the input as read (`counts.vertices`).
+    pub vertices: usize,
+    /// `counts.fallback_weighted_vertices`: vertices no region reached, weighted from the
+    /// nearest weighted vertex or the nearest bone, plus stored vertices no triangle uses.
+    pub fallback_weighted_vertices: usize,
+    /// The report's stages but writing, seconds.
+    pub weights_seconds: Option<f64>,
+    /// The whole `skin` command, seconds.
+    pub wall_seconds: f64,
+    /// Share of our skinned file's vertices bound to a single joint.
+    pub single_joint_share: Option<f64>,
+    /// The same for the reference weights.
+    pub reference_single_joint_share: Option<f64>,
+    /// Set when the file skins more vertices than the reader gave (several skins: the
+    /// reader reads the first).
+    pub partly_read: Option<String>,
+    pub warnings: Vec<String>,
+}
+
+impl SkinFacts {
+    /// `fallback_weighted_vertices` over `vertices`, the share issue 12 quotes.
+    pub fn fallback_share(&self) -> f64 {
+        self.fallback_weighted_vertices as f64 / self.vertices.max(1) as f64
+    }
+}
+
+/// Runs every character on a pool of `jobs` threads, each writing its files under `work`;
+/// `progress` is called as each one ends. Results are in the order of `characters`.
+pub fn run_all(
+    exe: &Path,
+    characters: &[Character],
+    work: &Path,
+    jobs: usize,
+    progress: &(dyn Fn(&CharacterResult) + Sync),
+) -> Result<Vec<CharacterResult>> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs.max(1))
+        .build()
+        .context("cannot start the worker threads")?;
+    Ok(pool.install(|| {
+        characters
+            .par_iter()
+            .map(|character| {
+                let result = run_character(exe, character, work);
+                progress(&result);
+                result
+            })
+            .collect()
+    }))
+}
+
+/// Skins and judges one character; never fails: a failure is the result.
+pub fn run_character(exe: &Path, character: &Character, work: &Path) -> CharacterResult {
+    let outcome = match score(exe, character, work) {
+        Ok(scored) => Outcome::Scored(Box::new(scored)),
+        Err((stage, error)) => Outcome::Failed {
+            stage: stage.to_string(),
+            reason: format!("{error:#}").replace('\n', " "),
+        },
+    };
+    CharacterResult {
+        set: character.set,
+        name: character.name.clone(),
+        rigid_by_artist: character.rigid_by_artist,
+        outcome,
+    }
+}
+
+type Staged<T> = std::result::Result<T, (&'static str, anyhow::Error)>;
+
+fn score(exe: &Path, character: &Character, work: &Path) -> Staged<Scored> {
+    let stem = work
+        .join(match character.set {
+            Set::Bench => "bench",
+            Set::Models => "models",
+        })
+        .join(character.name.trim_end_matches(".glb"));
+    let candidate = stem.with_extension("glb");
+    let report_path = stem.with_extension("report.json");
+    let skin = |e: anyhow::Error| ("skin", e);
+    if let Some(folder) = candidate.parent() {
+        std::fs::create_dir_all(folder)
+            .with_context(|| format!("cannot create {}", folder.display()))
+            .map_err(skin)?;
+    }
+    let run = run_skin(exe, &character.skin_args, &candidate, &report_path).map_err(skin)?;
+    let facts = skin_facts(character, &run, &candidate).map_err(skin)?;
+    let start = Instant::now();
+    let evaluation = run_eval(
+        exe,
+        &character.reference_args,
+        &candidate,
+        character.prune_reference,
+        WORST_VERTICES,
+    )
+    .map_err(|e| ("eval", e))?;
+    Ok(Scored {
+        evaluation,
+        skin: facts,
+        eval_seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// The report's counts, timings and warnings, the single-joint shares of our file and of
+/// the reference, and whether the reader took every skinned vertex of a glTF input.
+fn skin_facts(character: &Character, run: &SkinRun, candidate: &Path) -> Result<SkinFacts> {
+    let report = &run.report;
+    let count = |key: &str| {
+        report["counts"][key]
+            .as_u64()
+            .map(|n| n as usize)
+            .with_context(|| format!("the skin report has no counts.{key}"))
+    };
+    let vertices = count("vertices")?;
+    let ours = atlas_skin_io::load_character(candidate, &Default::default())
+        .with_context(|| format!("cannot read our skinned {}", candidate.display()))?;
+    let reference = atlas_skin_io::load_character(&character.input, &character.reference_options)
+        .with_context(|| format!("cannot read {}", character.input.display()))?;
+    let is_gltf = character
+        .input
+        .extension()
+        .is_some_and(|e| e == "glb" || e == "gltf");
+    let partly_read = if is_gltf {
+        let file = skinned_meshes(&character.input)?;
+        (file.vertices > vertices).then(|| {
+            format!(
+                "the file has {} skinned meshes on {} skins ({} vertices); the reader gave {vertices}",
+                file.nodes, file.skins, file.vertices
+            )
+        })
+    } else {
+        None
+    };
+    Ok(SkinFacts {
+        vertices,
+        fallback_weighted_vertices: count("fallback_weighted_vertices")?,
+        weights_seconds: run.weights_seconds,
+        wall_seconds: run.wall_seconds,
+        single_joint_share: ours.reference_weights.as_ref().and_then(single_joint_share),
+        reference_single_joint_share: reference
+            .reference_weights
+            .as_ref()
+            .and_then(single_joint_share),
+        partly_read,
+        warnings: report["warnings"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .filter_map(|w| w.as_str().map(String::from))
+            .collect(),
+    })
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use atlas_skin_eval::{Bleeding, DeformError, Validity, WeightsL1};
+
+    /// A scored bench character with these deformation errors (L1 0.5, bleed 0.1, 100
+    /// vertices of which `fallback` fell back, half of them bound to a single joint).
+    pub(crate) fn scored(name: &str, mean: f64, max: f64, fallback: usize) -> CharacterResult {
+        let deform = DeformError { mean, max };
+        CharacterResult {
+            set: Set::Bench,
+            name: name.to_string(),
+            rigid_by_artist: Some(false),
+            outcome: Outcome::Scored(Box::new(Scored {
+                evaluation: Evaluation {
+                    vertices: 100,
+                    joints: 5,
+                    matched: 100,
+                    candidate_vertices: 100,
+                    candidate_joints: 5,
+                    weights_l1: WeightsL1 {
+                        mean: 0.5,
+                        p95: 1.0,
+                        max: 1.5,
+                        dominant_agreement: 0.9,
+                    },
+                    deform_random: deform,
+                    deform_random_dqs: deform,
+                    deform_anim: None,
+                    bleeding: Bleeding { fraction: 0.1 },
+                    validity: Validity {
+                        negative_weights: 0,
+                        sums_off_one: 0,
+                        unweighted_vertices: 0,
+                        max_influences: 4,
+                        mean_influences: 2.0,
+                    },
+                    worst_vertices: Vec::new(),
+                },
+                skin: SkinFacts {
+                    vertices: 100,
+                    fallback_weighted_vertices: fallback,
+                    weights_seconds: Some(0.004),
+                    wall_seconds: 0.01,
+                    single_joint_share: Some(0.5),
+                    reference_single_joint_share: Some(1.0),
+                    partly_read: None,
+                    warnings: Vec::new(),
+                },
+                eval_seconds: 0.02,
+            })),
+        }
+    }
+
+    pub(crate) fn failed(name: &str) -> CharacterResult {
+        CharacterResult {
+            set: Set::Bench,
+            name: name.to_string(),
+            rigid_by_artist: Some(true),
+            outcome: Outcome::Failed {
+                stage: "skin".into(),
+                reason: "the mesh has no triangles".into(),
+            },
+        }
+    }
+
+    pub(crate) fn run(commit: &str, characters: Vec<CharacterResult>) -> BenchmarkRun {
+        BenchmarkRun {
+            commit: commit.into(),
+            settings: Settings::of_eval(),
+            jobs: 2,
+            wall_seconds: 1.5,
+            load_average: Some((0.5, 0.7)),
+            characters,
+        }
+    }
+
+    #[test]
+    fn a_run_round_trips_through_json() {
+        let run = run("abc", vec![scored("a.glb", 0.01, 0.1, 3), failed("b.glb")]);
+        let text = serde_json::to_string(&run).unwrap();
+        assert!(text.contains(r#""status":"failed""#));
+        assert_eq!(serde_json::from_str::<BenchmarkRun>(&text).unwrap(), run);
+        assert_eq!(run.characters[0].figures().unwrap().deform_max, 0.1);
+        assert_eq!(run.characters[1].figures(), None);
+        assert_eq!(
+            run.characters[0].scored().unwrap().skin.fallback_share(),
+            0.03
+        );
+    }
+
+    #[test]
+    fn eval_settings_are_baselines_md() {
+        let s = Settings::of_eval();
+        assert_eq!((s.poses, s.first_seed, s.max_angle_degrees), (10, 0, 60.0));
+    }
+
+    /// The real thing on two small characters: a smooth and a rigid one of the benchmark,
+    /// through the released binary (built by `cargo test` of the workspace or the scripts).
+    #[test]
+    fn two_real_characters_are_skinned_and_judged() {
+        // The test binary lives in target/release/deps, the CLI one folder up (built by the
+        // workspace's `cargo test --all-targets` or by the scripts).
+        let test_exe = std::env::current_exe().unwrap();
+        let exe = test_exe
+            .parent()
+            .unwrap()
+            .parent()
+            .unwrap()
+            .join("atlas-skin");
+        assert!(
+            exe.is_file(),
+            "{} is missing: cargo build --release -p atlas-skin-cli",
+            exe.display()
+        );
+        let bench = Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../../shared/data/bench"
+        ));
+        let characters: Vec<Character> = crate::bench_characters::bench_characters(bench)
+            .expect("the benchmark characters are missing: ../shared/data/bench")
+            .into_iter()
+            .filter(|c| c.name == "rignet-val/426.glb" || c.name == "rignet-val/9452.glb")
+            .collect();
+        assert_eq!(characters.len(), 2);
+        let work = std::env::temp_dir().join(format!("bench-run-{}", std::process::id()));
+        let results = run_all(&exe, &characters, &work, 2, &|_| {}).unwrap();
+        for result in &results {
+            let s = result.scored().unwrap_or_else(|| panic!("{result:?}"));
+            assert_eq!(s.evaluation.matched, s.evaluation.vertices);
+            assert_eq!(s.evaluation.worst_vertices.len(), WORST_VERTICES);
+            assert!(s.evaluation.deform_random.mean > 0.0);
+            assert!(s.skin.vertices > 0 && s.skin.weights_seconds.is_some());
+            let artist = s.skin.reference_single_joint_share.unwrap();
+            if result.rigid_by_artist == Some(true) {
+                assert_eq!(artist, 1.0, "{}", result.name);
+            } else {
+                assert!(artist < 1.0, "{}", result.name);
+            }
+        }
+        // A character whose file is not a glTF gives a failed result, not an abort.
+        let mut broken = characters[0].clone();
+        broken.name = "broken.glb".into();
+        let text = work.join("broken.glb");
+        std::fs::write(&text, "not a glb").unwrap();
+        broken.skin_args = vec![text.clone().into_os_string()];
+        broken.input = text;
+        let result = run_character(&exe, &broken, &work);
+        match &result.outcome {
+            Outcome::Failed { stage, reason } => {
+                assert_eq!(stage, "skin");
+                assert!(reason.contains("broken.glb"), "{reason}");
+            }
+            Outcome::Scored(_) => panic!("a text file was scored"),
+        }
+        std::fs::remove_dir_all(&work).unwrap();
+    }
+}
