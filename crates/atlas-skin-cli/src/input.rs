@@ -87,7 +87,7 @@ pub fn skin_character(character: &mut Character) -> Result<()> {
     Ok(())
 }
 
-/// The built-in demo character ([`atlas_skin::demo`]) as if read from a file named
+/// The built-in demo character ([`atlas_skin::fixtures::demo`]) as if read from a file named
 /// `demo`: mesh and skeleton, no weights.
 pub fn demo_character() -> Character {
     let demo = atlas_skin::fixtures::demo::demo_character(atlas_skin::fixtures::demo::DEFAULT_STEP);

@@ -48,7 +48,7 @@ impl BaselineTable {
 const TOOL_HEADER: &str = ": deform mean / max, L1, bleed";
 
 /// Reads the table whose header starts with `| character |`; tool columns are those whose
-/// header ends with [`TOOL_HEADER`], cells `MEAN / MAX, L1, BLEED` or `failed`.
+/// header ends with `TOOL_HEADER`, cells `MEAN / MAX, L1, BLEED` or `failed`.
 pub fn parse_bench_baselines(text: &str) -> Result<BaselineTable> {
     let mut header: Option<Vec<String>> = None;
     let mut table = BaselineTable {

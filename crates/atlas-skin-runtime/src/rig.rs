@@ -115,7 +115,7 @@ impl Rig {
     /// World matrix of every node: `world[n] = world[parent(n)] · local[n].matrix()`
     /// (roots: `local[n].matrix()`).
     ///
-    /// - `local`: #N local transforms (a [`Clip::sample`] output, or `rest`).
+    /// - `local`: #N local transforms (a [`crate::Clip::sample`] output, or `rest`).
     /// - `out_world`: #N matrices.
     ///
     /// glTF does not order parents before children, so a node whose parent comes later is

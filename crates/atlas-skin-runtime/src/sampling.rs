@@ -132,7 +132,7 @@ impl Clip {
     /// Local transforms of every rig node at `time` seconds: the rest transform with the
     /// animated properties replaced by [`Track::sample`] (rotations renormalised).
     ///
-    /// - `rig_rest`: #N rest local transforms ([`Rig::rest`]); `out_local`: #N outputs.
+    /// - `rig_rest`: #N rest local transforms ([`crate::Rig::rest`]); `out_local`: #N outputs.
     pub fn sample(&self, time: f32, rig_rest: &[Trs], out_local: &mut [Trs]) {
         debug_assert_eq!(rig_rest.len(), out_local.len());
         out_local.copy_from_slice(rig_rest);

@@ -43,7 +43,7 @@ impl Default for WriteOptions {
 ///   into the single BIN chunk). Other input: a new document with the mesh, smooth normals,
 ///   joint nodes in the bind pose and a skin.
 /// - Weights per vertex: the `max_influences` largest, normalised in the stored float32
-///   (see [`pack_weights`]); a vertex without any weight is bound fully to joint 0.
+///   (see `pack_weights`); a vertex without any weight is bound fully to joint 0.
 ///
 /// # Errors
 /// [`IoError::WouldOverwriteInput`] when `out` is the input file; [`IoError::Invalid`]

@@ -12,7 +12,7 @@
 //!    λ_i = max_k (w_k − g_k) / (2 w_k) when it does not (k over V_i's cuts reaching p).
 //!    Both give ½ on a curve, so λ_i is continuous across it; regions with λ_i ≤ 0 are not
 //!    related.
-//! 2. **Blend** the related regions: ω_i from the λ_i by [`blend_regions`].
+//! 2. **Blend** the related regions: ω_i from the λ_i by [`blend::blend_regions`].
 //! 3. **Chain weights inside a region.** A region is bound to its first joint; each other
 //!    joint of the region with a soft boundary also moves part of it. Joint c's soft boundary
 //!    (plane point o_c, normal n_c toward its child, half-width w_c) gives

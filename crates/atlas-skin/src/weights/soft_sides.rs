@@ -45,7 +45,7 @@ impl SoftSide {
 /// Step 3's child sides: for each soft boundary, a flood along edges from the vertices of
 /// the joint's cross-section (within the band |n·(p − o)| ≤ w and within max(D, w) of the
 /// joint), through vertices related to the boundary's region whose signed plane distance
-/// exceeds −w and where κ > 0 ([`Ownership`]). A soft boundary with no
+/// exceeds −w and where κ > 0 ([`super::ownership`]). A soft boundary with no
 /// cross-section (diameter 0, or no band vertex near the joint where κ > 0: face bones in
 /// a mouth cavity or an eye socket) is inactive: its joint gets no weight and its region's
 /// other joints keep it.

@@ -4,7 +4,7 @@
 use serde::Serialize;
 
 /// Weights of every vertex of the split surface, in compressed rows like
-/// [`VertexWeights`]: vertex v's (joint, weight) pairs are at `offsets[v]..offsets[v + 1]`,
+/// [`VertexWeights`](atlas_skin_runtime::VertexWeights): vertex v's (joint, weight) pairs are at `offsets[v]..offsets[v + 1]`,
 /// weights positive and summing to 1, joints distinct.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SurfaceWeights {
