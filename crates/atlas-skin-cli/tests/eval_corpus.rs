@@ -256,5 +256,16 @@ fn swapped_joints_give_the_weight_difference_worked_out_from_the_data() {
             let swapped = candidate.iter().find(|(j, _)| j == other).unwrap();
             assert!((swapped.1 - weight).abs() < 1e-5, "{w}");
         }
+        // Every joint's bones are at least as far as the nearest bone, and the nearest
+        // bone's joint has ratio 1.
+        let ratios: Vec<f64> = ["reference", "candidate"]
+            .iter()
+            .flat_map(|key| w[*key].as_array().unwrap().iter())
+            .map(|r| {
+                assert!(r["bone_distance"].as_f64().unwrap() >= 0.0, "{r}");
+                r["bone_distance_ratio"].as_f64().unwrap()
+            })
+            .collect();
+        assert!(ratios.iter().all(|&x| x >= 1.0 - 1e-12), "{w}");
     }
 }

@@ -22,6 +22,7 @@ pub use worst::{JointWeight, WorstVertex};
 
 use atlas_skin::mesh::weld::UNREFERENCED;
 use atlas_skin::mesh::{Topology, Welded};
+use atlas_skin::skeleton::bones::bone_segments;
 use atlas_skin_runtime::{Clip, Rig, RuntimeError, Skeleton, VertexWeights};
 use glam::{Mat4, Vec3};
 use serde::{Deserialize, Serialize};
@@ -251,6 +252,8 @@ pub fn evaluate(input: &EvalInput, options: &EvalOptions) -> Result<Evaluation, 
                 reference: &aligned.reference,
                 candidate: &aligned.candidate,
                 names: &reference.skeleton.names,
+                segments: &bone_segments(reference.skeleton),
+                diagonal,
             },
             options.worst,
         ),

@@ -2,15 +2,24 @@
 //! when a weighting goes wrong.
 
 use super::deform::VertexError;
+use atlas_skin::geometry::point_segment_distance;
 use atlas_skin_runtime::VertexWeights;
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 
-/// One joint's weight in a row, by name.
+/// One joint's weight in a row, by name, with how far the joint's bones are from the
+/// vertex.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct JointWeight {
     pub joint: String,
     pub weight: f32,
+    /// Distance from the vertex to the nearest bone segment the joint moves
+    /// ([`atlas_skin::skeleton::bones::bone_segments`]), in units of the diagonal.
+    pub bone_distance: f64,
+    /// `bone_distance` over the distance to the nearest bone of any joint (1 for the
+    /// nearest bone itself): a weight on a joint whose bones are several times farther than
+    /// the nearest is a gross misassignment.
+    pub bone_distance_ratio: f64,
 }
 
 /// A vertex with a large deformation error, and the two weight rows that cause it.
@@ -37,6 +46,10 @@ pub struct Rows<'a> {
     pub candidate: &'a VertexWeights,
     /// Joint names of the reference skeleton, which both rows index.
     pub names: &'a [String],
+    /// Bone segments of the reference skeleton ([`bone_segments`]).
+    pub segments: &'a [(u32, DVec3, DVec3)],
+    /// Length of the mesh's bounding-box diagonal.
+    pub diagonal: f64,
 }
 
 /// The `count` rows with the largest `errors[m].max`, worst first (ties by row order).
@@ -51,20 +64,41 @@ pub fn worst_vertices(errors: &[VertexError], rows: &Rows, count: usize) -> Vec<
             position: rows.positions[m].to_array(),
             error: errors[m].max,
             pose: errors[m].palette,
-            reference: named_row(rows.reference, m, rows.names),
-            candidate: named_row(rows.candidate, m, rows.names),
+            reference: named_row(rows.reference, m, rows),
+            candidate: named_row(rows.candidate, m, rows),
         })
         .collect()
 }
 
-/// Row `m` of `weights` with joint names, heaviest first, zero weights dropped.
-fn named_row(weights: &VertexWeights, m: usize, names: &[String]) -> Vec<JointWeight> {
+/// Row `m` of `weights` with joint names and bone distances, heaviest first, zero weights
+/// dropped.
+fn named_row(weights: &VertexWeights, m: usize, rows: &Rows) -> Vec<JointWeight> {
+    let p = rows.positions[m].as_dvec3();
+    let bone_distance = |joint: Option<u32>| {
+        rows.segments
+            .iter()
+            .filter(|&&(j, _, _)| joint.is_none() || joint == Some(j))
+            .map(|&(_, a, b)| point_segment_distance(p, a, b))
+            .fold(f64::INFINITY, f64::min)
+    };
+    let nearest = bone_distance(None);
     let mut row: Vec<JointWeight> = weights
         .row(m)
         .filter(|&(_, w)| w != 0.0)
-        .map(|(j, weight)| JointWeight {
-            joint: names[j as usize].clone(),
-            weight,
+        .map(|(j, weight)| {
+            let distance = bone_distance(Some(j));
+            JointWeight {
+                joint: rows.names[j as usize].clone(),
+                weight,
+                bone_distance: distance / rows.diagonal,
+                bone_distance_ratio: if nearest > 0.0 {
+                    distance / nearest
+                } else if distance > 0.0 {
+                    f64::INFINITY
+                } else {
+                    1.0
+                },
+            }
         })
         .collect();
     row.sort_by(|a, b| b.weight.total_cmp(&a.weight));
@@ -88,6 +122,12 @@ mod tests {
             reference: &weights,
             candidate: &candidate,
             names: &names,
+            // Joint a moves the bone along X from the origin, b the bone along Z from 2Y.
+            segments: &[
+                (0, DVec3::ZERO, DVec3::X),
+                (1, DVec3::Y * 2.0, DVec3::new(0.0, 2.0, 1.0)),
+            ],
+            diagonal: 2.0,
         };
         let worst = worst_vertices(&errors, &rows, 2);
         assert_eq!(worst.len(), 2);
@@ -97,6 +137,11 @@ mod tests {
         assert_eq!(worst[0].reference[0].joint, "b");
         assert_eq!(worst[0].reference[1].weight, 0.25);
         assert_eq!(worst[0].candidate.len(), 1);
+        // Vertex 8 at (0, 1, 0): 1 from a's bone, 1 from b's; vertex 9 at Z: 1 and √(4 + 0) = 2.
+        assert_eq!(worst[0].candidate[0].bone_distance, 0.5);
+        assert_eq!(worst[0].candidate[0].bone_distance_ratio, 1.0);
+        assert_eq!(worst[1].candidate[0].joint, "b");
+        assert!((worst[1].candidate[0].bone_distance_ratio - 2.0).abs() < 1e-12);
         assert!(worst_vertices(&errors, &rows, 0).is_empty());
     }
 }

@@ -164,11 +164,17 @@ fn summary(e: &Evaluation) -> String {
     .collect()
 }
 
-/// One line of the worst-vertex list.
+/// One line of the worst-vertex list: each joint's weight, and after `@` how many times
+/// farther its bones are than the nearest bone (×1: the nearest).
 fn worst_line(w: &atlas_skin_eval::WorstVertex) -> String {
     let row = |r: &[atlas_skin_eval::JointWeight]| {
         r.iter()
-            .map(|jw| format!("{} {:.2}", jw.joint, jw.weight))
+            .map(|jw| {
+                format!(
+                    "{} {:.2} @×{:.1}",
+                    jw.joint, jw.weight, jw.bone_distance_ratio
+                )
+            })
             .collect::<Vec<_>>()
             .join(", ")
     };
