@@ -14,11 +14,14 @@ pub struct JointWeight {
     pub joint: String,
     pub weight: f32,
     /// Distance from the vertex to the nearest bone segment the joint moves
-    /// ([`atlas_skin::skeleton::bones::bone_segments`]), in units of the diagonal.
+    /// ([`atlas_skin::skeleton::bones::bone_segments`]), in units of the diagonal (0 in
+    /// JSON written before this field existed).
+    #[serde(default)]
     pub bone_distance: f64,
     /// `bone_distance` over the distance to the nearest bone of any joint (1 for the
     /// nearest bone itself): a weight on a joint whose bones are several times farther than
     /// the nearest is a gross misassignment.
+    #[serde(default)]
     pub bone_distance_ratio: f64,
 }
 

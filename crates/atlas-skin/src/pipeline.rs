@@ -1,7 +1,8 @@
 //! The whole method, from the mesh as stored to weights per stored vertex:
 //! weld ([`crate::mesh::weld()`]) → topology → decomposition (§3.1 cuts, §3.2 regions:
 //! [`crate::decompose()`]) → overlaps (§3.3: [`crate::overlap`]) → weights (§4, §5:
-//! [`crate::weights`]) → un-weld (weights per stored vertex, pruned to `max_influences`).
+//! [`crate::weights`], then the guard against far bones, [`crate::weights::guard`]) →
+//! un-weld (weights per stored vertex, pruned to `max_influences`).
 //! Settings are validated once, before any work; each stage's wall time is measured here.
 //!
 //! Inputs: a [`SkinInput`] (stored positions and triangles, the skeleton in the mesh's bind
@@ -14,6 +15,7 @@ use crate::mesh::{weld, Topology, Welded};
 use crate::overlap::{compute_overlaps, OverlapError, OverlapParams, Overlaps};
 use crate::skeleton::bones::{bone_segments, nearest_bone};
 use crate::weights::blend::Blend;
+use crate::weights::guard::guard_far_bones;
 use crate::weights::{compute_weights, SurfaceWeights, WeightCounts, WeightsError};
 use atlas_skin_runtime::{RuntimeError, Skeleton, VertexWeights};
 use glam::Vec3;
@@ -198,8 +200,10 @@ pub fn skin(
     done(&mut timings);
 
     let done = run(Stage::Weights);
-    let (surface_weights, weight_counts) =
+    let (mut surface_weights, mut weight_counts) =
         compute_weights(&decomposition, input.skeleton, &overlaps, params.blend)?;
+    weight_counts.far_bone_vertices =
+        guard_far_bones(&decomposition, input.skeleton, &mut surface_weights);
     let weights = unweld_weights(
         &surface_weights,
         &welded.welded_of_stored,

@@ -271,6 +271,7 @@ fn report(
                 + counts.unreferenced_stored_vertices,
             "max_influences": skinned.weights.max_influences(),
             "leaf_patches": weight_counts.leaf_patches.len(),
+            "far_bone_vertices": weight_counts.far_bone_vertices,
         },
         "warnings": warnings,
     })

@@ -59,6 +59,9 @@
 //!    degenerate bit, a region without joints) copies the weights of the nearest weighted
 //!    vertex along the surface's edges (Dijkstra) when its component has one, and is bound
 //!    to the nearest bone segment otherwise ([`crate::skeleton::bones`]).
+//! 5. **Guard.** A weight on a joint whose bones are far from the vertex, many times
+//!    farther than the nearest bone reached through the body, is removed and the row
+//!    renormalised ([`guard`]); the pipeline runs it on the result of steps 1–4.
 //!
 //! Inputs: a [`Decomposition`], the decomposed skeleton, its [`Overlaps`]
 //! ([`crate::overlap`]) and the [`Blend`]. Output: [`SurfaceWeights`], weights of every
@@ -68,6 +71,7 @@
 pub mod blend;
 pub mod chains;
 pub mod fallback;
+pub mod guard;
 pub mod ownership;
 pub mod patches;
 pub mod related;
