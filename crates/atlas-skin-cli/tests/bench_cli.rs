@@ -104,8 +104,9 @@ fn pose_runs_on_the_demo_character() {
 }
 
 /// `--write-data` writes the side-by-side data file of ../shared/perf/README.md (header,
-/// then 48 bytes per vertex and 64 per joint), `--batch` times samples of several frames;
-/// a folder as the data file is refused with its name, and nothing is left behind.
+/// then 48 bytes per vertex and 64 per joint), `--batch` times samples of several frames,
+/// `--instruction-set` picks the loops (the portable ones run on every CPU); a folder as
+/// the data file and an unknown instruction set are refused with their names.
 #[test]
 fn bench_writes_side_by_side_data() {
     let data = test_file("bench_cli", "demo.bin");
@@ -116,11 +117,14 @@ fn bench_writes_side_by_side_data() {
         "2",
         "--batch",
         "3",
+        "--instruction-set",
+        "portable",
         "--write-data",
         data.to_str().expect("UTF-8 path"),
     ]);
     let report: Value = serde_json::from_str(&text).expect("one JSON object");
     assert_eq!(report["batch"], 3, "{report}");
+    assert_eq!(report["instruction_set"], "portable", "{report}");
     assert_eq!(report["allocations_per_frame"], 0.0, "{report}");
     let bytes = std::fs::read(&data).expect("data file written");
     let int = |at: usize| i32::from_le_bytes(bytes[at..at + 4].try_into().expect("4 bytes"));
@@ -155,4 +159,8 @@ fn bench_writes_side_by_side_data() {
         message.contains(folder.to_str().expect("UTF-8 path")),
         "{message}"
     );
+    let failed = support::atlas_skin(&["bench", "--frames", "1", "--instruction-set", "sse9"]);
+    assert!(!failed.status.success());
+    let message = String::from_utf8_lossy(&failed.stderr);
+    assert!(message.contains("\"sse9\""), "{message}");
 }

@@ -25,7 +25,8 @@ use anyhow::{ensure, Context, Result};
 use atlas_skin_runtime::random_pose::random_rotations;
 use atlas_skin_runtime::skinning_job::PARALLEL_CHUNK;
 use atlas_skin_runtime::{
-    CompactSkin, SkinningJob, SkinningMethod, SkinningPalette, Threading, VertexWeights,
+    CompactSkin, InstructionSet, SkinningJob, SkinningMethod, SkinningPalette, Threading,
+    VertexWeights,
 };
 use glam::{Mat4, Vec3};
 use rayon::prelude::*;
@@ -87,6 +88,9 @@ pub struct Args {
     /// so that both see the machine's load alike).
     #[arg(long, default_value_t = 1)]
     pub batch: usize,
+    /// The skinning loops: portable, avx2 or avx512 (default: the widest this CPU runs).
+    #[arg(long, value_name = "NAME")]
+    pub instruction_set: Option<String>,
     /// Print the figures as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -104,6 +108,8 @@ pub struct BenchReport {
     pub threads: usize,
     pub frames: usize,
     pub batch: usize,
+    /// The skinning loops that ran ([`InstructionSet::name`]).
+    pub instruction_set: &'static str,
     pub influences: usize,
     pub lbs_vertices_per_second: f64,
     pub dqs_vertices_per_second: f64,
@@ -122,6 +128,10 @@ pub fn run(args: Args) -> Result<()> {
     ensure!(args.threads >= 1, "--threads must be at least 1");
     ensure!(args.frames >= 1, "--frames must be at least 1");
     ensure!(args.batch >= 1, "--batch must be at least 1");
+    let set = match &args.instruction_set {
+        Some(name) => InstructionSet::from_name(name)?,
+        None => InstructionSet::best(),
+    };
     let character = args.input.load_skinned()?;
     let posable = Posable::new(&character)?;
     let weights = character
@@ -159,8 +169,15 @@ pub fn run(args: Args) -> Result<()> {
     } else {
         Threading::Parallel
     };
-    let timings =
-        pool.install(|| measure(&mut streams, &palettes, threading, args.frames, args.batch))?;
+    let timings = pool.install(|| {
+        measure(
+            &mut streams,
+            &palettes,
+            (threading, set),
+            args.frames,
+            args.batch,
+        )
+    })?;
     let frames = (args.frames * args.batch) as f64;
     let lbs_rate = count as f64 / timings.lbs;
     let dqs_rate = count as f64 / timings.dqs;
@@ -171,6 +188,7 @@ pub fn run(args: Args) -> Result<()> {
         threads: args.threads,
         frames: args.frames,
         batch: args.batch,
+        instruction_set: set.name(),
         influences: streams.skin.influences(),
         lbs_vertices_per_second: lbs_rate,
         dqs_vertices_per_second: dqs_rate,
@@ -190,8 +208,8 @@ pub fn run(args: Args) -> Result<()> {
 
 fn print_report(r: &BenchReport) {
     println!(
-        "{} vertices, {} influences, {} thread(s), {} samples of {} frame(s) per method",
-        r.vertices, r.influences, r.threads, r.frames, r.batch
+        "{} vertices, {} influences, {} thread(s), {} loops, {} samples of {} frame(s) per method",
+        r.vertices, r.influences, r.threads, r.instruction_set, r.frames, r.batch
     );
     println!(
         "linear blend:    {:8.1} M vertices/s ({:.0}% of copy bandwidth)",
@@ -263,7 +281,7 @@ impl Streams {
         palette: &mut SkinningPalette,
         poses: impl ExactSizeIterator<Item = &'p Vec<Mat4>>,
         method: SkinningMethod,
-        threading: Threading,
+        (threading, set): (Threading, InstructionSet),
     ) -> Result<f64> {
         let count = poses.len() as f64;
         let start = Instant::now();
@@ -282,7 +300,7 @@ impl Streams {
                 out_normals: Some(&mut self.out_normals),
                 out_tangents: None,
             }
-            .run()?;
+            .run_with(set)?;
         }
         Ok(start.elapsed().as_secs_f64() / count)
     }
@@ -325,7 +343,7 @@ struct Timings {
 fn measure(
     streams: &mut Streams,
     palettes: &[Vec<Mat4>],
-    threading: Threading,
+    threading: (Threading, InstructionSet),
     frames: usize,
     batch: usize,
 ) -> Result<Timings> {
