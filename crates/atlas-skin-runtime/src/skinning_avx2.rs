@@ -15,6 +15,7 @@ use crate::dual_quaternion::DualQuat;
 use crate::skinning_job::{specialise, Kernel, Span};
 use glam::{Mat4, Vec3, Vec4};
 use std::arch::x86_64::*;
+use std::ops::Range;
 
 /// True when this CPU runs the loops of this module.
 pub(crate) fn available() -> bool {
@@ -179,20 +180,22 @@ unsafe fn blend_dual_quaternions(
     (real, dual)
 }
 
-/// [`blend_dual_quaternions`] of vertex `v` of a span with `k` influences per vertex.
+/// [`blend_dual_quaternions`] of the first `used` influences of vertex `v` of a span with
+/// `k` influences per vertex.
 ///
 /// # Safety
-/// As [`blend_dual_quaternions`]; `v` is a vertex of the span `joints` and `explicit` start.
+/// As [`blend_dual_quaternions`]; `v` is a vertex of the span `joints` and `explicit` start,
+/// `used ≤ k` covers every positive weight of its row.
 #[target_feature(enable = "avx2,fma")]
 #[inline]
 unsafe fn blend_vertex(
     palette: *const f32,
-    joints: *const u16,
-    explicit: *const f32,
+    (joints, explicit): (*const u16, *const f32),
     v: usize,
     k: usize,
+    used: usize,
 ) -> (__m128, __m128) {
-    blend_dual_quaternions(palette, joints.add(v * k), explicit.add(v * (k - 1)), k)
+    blend_dual_quaternions(palette, joints.add(v * k), explicit.add(v * (k - 1)), used)
 }
 
 /// `2 / x` by the reciprocal estimate and one Newton step, `y' = y (2 − x y)` (relative
@@ -373,9 +376,42 @@ unsafe fn write_vertex<const NORMALS: bool, const TANGENTS: bool>(
 unsafe fn linear_blend_span<const K: usize, const NORMALS: bool, const TANGENTS: bool>(
     palette: &[Mat4],
     k: usize,
-    span: Span,
+    mut span: Span,
 ) {
     let k = if K == 0 { k } else { K };
+    for (vertices, used) in span.blocks(k) {
+        let block: BlockLoop = match used {
+            1 => linear_blend_block::<1, NORMALS, TANGENTS>,
+            2 => linear_blend_block::<2, NORMALS, TANGENTS>,
+            3 => linear_blend_block::<3, NORMALS, TANGENTS>,
+            4 => linear_blend_block::<4, NORMALS, TANGENTS>,
+            _ => linear_blend_block::<0, NORMALS, TANGENTS>,
+        };
+        block(palette, &mut span, vertices, k, used);
+    }
+}
+
+/// A loop over one block of vertices: palette, span, the block's vertices, K (the
+/// stride of the span's rows) and the influences the block uses.
+type BlockLoop = unsafe fn(&[Mat4], &mut Span, Range<usize>, usize, usize);
+
+/// Vertices `vertices` of the span, blending their first `USED` influences (or `used`
+/// when `USED` is 0) of the `k` stored per row; every vertex but the span's last stores
+/// each vector as 16 bytes over the next vertex ([`store_vec3_over_next`]).
+///
+/// # Safety
+/// As [`linear_blend_span`]; `vertices` within the span, `used ≤ k` covering every
+/// positive weight of these rows.
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+unsafe fn linear_blend_block<const USED: usize, const NORMALS: bool, const TANGENTS: bool>(
+    palette: &[Mat4],
+    span: &mut Span,
+    vertices: Range<usize>,
+    k: usize,
+    used: usize,
+) {
+    let used = if USED == 0 { used } else { USED };
     let palette = palette.as_ptr().cast::<f32>();
     let count = span.len();
     let (joints, weights) = (span.joints.as_ptr(), span.weights.as_ptr());
@@ -384,8 +420,8 @@ unsafe fn linear_blend_span<const K: usize, const NORMALS: bool, const TANGENTS:
     let out_positions = span.out_positions.as_mut_ptr();
     let out_normals = span.out_normals.as_mut_ptr();
     let (one, zero) = (_mm256_set1_ps(1.0), _mm256_setzero_ps());
-    for v in 0..count {
-        let (lo, hi) = blend_matrices(palette, joints.add(v * k), weights.add(v * (k - 1)), k);
+    for v in vertices {
+        let (lo, hi) = blend_matrices(palette, joints.add(v * k), weights.add(v * (k - 1)), used);
         let position = half_products(lo, hi, rest_positions.add(3 * v), one);
         let last = v + 1 == count;
         if NORMALS {
@@ -413,8 +449,10 @@ unsafe fn linear_blend_span<const K: usize, const NORMALS: bool, const TANGENTS:
     }
 }
 
-/// Vertices per batch of the dual quaternion loop: one per lane of a 256-bit register.
+/// Vertices per batch of the dual quaternion loop: one per lane of a 256-bit register,
+/// and one block of [`crate::compact_skin::INFLUENCE_BLOCK`].
 const LANES: usize = 8;
+const _: () = assert!(LANES == crate::compact_skin::INFLUENCE_BLOCK);
 
 /// # Safety
 /// As [`linear_blend_span`].
@@ -434,21 +472,16 @@ unsafe fn dual_quaternion_span<const K: usize, const NORMALS: bool, const TANGEN
     } else {
         span.len() / LANES * LANES
     };
-    for start in (0..batched).step_by(LANES) {
-        // Vertices i and i + 4 share a register (the transpose's input), built as soon as
-        // both are blended: eight separate halves went through the stack and were read
-        // back as whole registers, a store-to-load forwarding stall (measured: 10% of the
-        // loop's time).
-        let mut reals = [_mm256_setzero_ps(); LANES / 2];
-        let mut duals = [_mm256_setzero_ps(); LANES / 2];
-        for i in 0..LANES / 2 {
-            let (real_low, dual_low) = blend_vertex(palette, joints, weights, start + i, k);
-            let (real_high, dual_high) =
-                blend_vertex(palette, joints, weights, start + i + LANES / 2, k);
-            reals[i] = _mm256_set_m128(real_high, real_low);
-            duals[i] = _mm256_set_m128(dual_high, dual_low);
-        }
-        let batch = DualQuaternionBatch::new(reals, duals);
+    let rows = (joints, weights);
+    for (start, (_, used)) in (0..batched).step_by(LANES).zip(span.blocks(k)) {
+        let blend: BatchBlend = match used {
+            1 => blend_batch::<1>,
+            2 => blend_batch::<2>,
+            3 => blend_batch::<3>,
+            4 => blend_batch::<4>,
+            _ => blend_batch::<0>,
+        };
+        let batch = blend(palette, rows, start, k, used);
         let positions = span.rest_positions.as_ptr().add(start);
         let moved = batch.point(load_vec3_batch(positions));
         store_vec3_batch(span.out_positions.as_mut_ptr().add(start), moved);
@@ -459,7 +492,7 @@ unsafe fn dual_quaternion_span<const K: usize, const NORMALS: bool, const TANGEN
         }
     }
     for v in batched..span.len() {
-        let blend = BlendedDualQuaternion::new(blend_vertex(palette, joints, weights, v, k));
+        let blend = BlendedDualQuaternion::new(blend_vertex(palette, rows, v, k, k));
         write_vertex::<NORMALS, TANGENTS>(
             &mut span,
             v,
@@ -468,6 +501,39 @@ unsafe fn dual_quaternion_span<const K: usize, const NORMALS: bool, const TANGEN
             |n| unsafe { blend.vector(n) },
         );
     }
+}
+
+/// A [`blend_batch`]: palette, rows, first vertex, K, influences used.
+type BatchBlend =
+    unsafe fn(*const f32, (*const u16, *const f32), usize, usize, usize) -> DualQuaternionBatch;
+
+/// The eight vertices from `start` blended over their first `USED` influences (or `used`
+/// when `USED` is 0).
+///
+/// # Safety
+/// As [`blend_vertex`] for each of the eight vertices.
+#[target_feature(enable = "avx2,fma")]
+unsafe fn blend_batch<const USED: usize>(
+    palette: *const f32,
+    rows: (*const u16, *const f32),
+    start: usize,
+    k: usize,
+    used: usize,
+) -> DualQuaternionBatch {
+    let used = if USED == 0 { used } else { USED };
+    // Vertices i and i + 4 share a register (the transpose's input), built as soon as
+    // both are blended: eight separate halves went through the stack and were read
+    // back as whole registers, a store-to-load forwarding stall (measured: 10% of the
+    // loop's time).
+    let mut reals = [_mm256_setzero_ps(); LANES / 2];
+    let mut duals = [_mm256_setzero_ps(); LANES / 2];
+    for i in 0..LANES / 2 {
+        let (real_low, dual_low) = blend_vertex(palette, rows, start + i, k, used);
+        let (real_high, dual_high) = blend_vertex(palette, rows, start + i + LANES / 2, k, used);
+        reals[i] = _mm256_set_m128(real_high, real_low);
+        duals[i] = _mm256_set_m128(dual_high, dual_low);
+    }
+    DualQuaternionBatch::new(reals, duals)
 }
 
 /// Eight blended dual quaternions, one per lane: real `(x, y, z, w)`, dual `(x, y, z, w)`,

@@ -14,6 +14,7 @@ use crate::skinning_avx2::{half_products, load_index, sum_both_halves, sum_halve
 use crate::skinning_job::{specialise, Kernel, Span};
 use glam::Mat4;
 use std::arch::x86_64::*;
+use std::ops::Range;
 
 /// True when this CPU runs the loops of this module.
 pub(crate) fn available() -> bool {
@@ -68,15 +69,45 @@ unsafe fn blend_matrices(
 }
 
 /// # Safety
-/// AVX-512F and VL present; the job's validation holds (joint indices below the palette
-/// length, streams of the span's length, `k ≥ 1` influences per vertex).
+/// AVX-512F, VL and DQ present; the job's validation holds (joint indices below the
+/// palette length, streams of the span's length, `k ≥ 1` influences per vertex).
 #[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2,fma")]
 unsafe fn linear_blend_span<const K: usize, const NORMALS: bool>(
     palette: &[Mat4],
     k: usize,
-    span: Span,
+    mut span: Span,
 ) {
     let k = if K == 0 { k } else { K };
+    for (vertices, used) in span.blocks(k) {
+        let block: InfluenceBlockLoop = match used {
+            1 => linear_blend_block::<1, NORMALS>,
+            2 => linear_blend_block::<2, NORMALS>,
+            3 => linear_blend_block::<3, NORMALS>,
+            4 => linear_blend_block::<4, NORMALS>,
+            _ => linear_blend_block::<0, NORMALS>,
+        };
+        block(palette, &mut span, vertices, (k, used));
+    }
+}
+
+/// A loop over one block: palette, span, the block's vertices, (K, influences used).
+type InfluenceBlockLoop = unsafe fn(&[Mat4], &mut Span, Range<usize>, (usize, usize));
+
+/// Vertices `vertices` of the span, blending their first `USED` influences (or `used`
+/// when `USED` is 0) of the `k` stored per row.
+///
+/// # Safety
+/// As [`linear_blend_span`]; `vertices` within the span, `used ≤ k` covering every
+/// positive weight of these rows.
+#[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2,fma")]
+#[inline]
+unsafe fn linear_blend_block<const USED: usize, const NORMALS: bool>(
+    palette: &[Mat4],
+    span: &mut Span,
+    vertices: Range<usize>,
+    (k, used): (usize, usize),
+) {
+    let used = if USED == 0 { used } else { USED };
     let palette = palette.as_ptr().cast::<f32>();
     let (joints, weights) = (span.joints.as_ptr(), span.weights.as_ptr());
     let rest_positions = span.rest_positions.as_ptr().cast::<f32>();
@@ -85,8 +116,8 @@ unsafe fn linear_blend_span<const K: usize, const NORMALS: bool>(
     let out_normals = span.out_normals.as_mut_ptr().cast::<f32>();
     let (one, zero) = (_mm256_set1_ps(1.0), _mm256_setzero_ps());
     const XYZ: __mmask8 = 0b0111;
-    for v in 0..span.len() {
-        let m = blend_matrices(palette, joints.add(v * k), weights.add(v * (k - 1)), k);
+    for v in vertices {
+        let m = blend_matrices(palette, joints.add(v * k), weights.add(v * (k - 1)), used);
         let (lo, hi) = (_mm512_castps512_ps256(m), _mm512_extractf32x8_ps::<1>(m));
         let position = half_products(lo, hi, rest_positions.add(3 * v), one);
         if NORMALS {

@@ -1,7 +1,7 @@
 //! Deforming a mesh by a palette: linear blend and dual quaternion skinning over
 //! caller-owned buffers (the shape of ozz-animation's SkinningJob).
 
-use crate::compact_skin::CompactSkin;
+use crate::compact_skin::{CompactSkin, INFLUENCE_BLOCK};
 use crate::dual_quaternion::DualQuat;
 use crate::instruction_set::InstructionSet;
 use crate::skinning_palette::{SkinningMethod, SkinningPalette};
@@ -11,6 +11,10 @@ use glam::{Mat4, Quat, Vec3, Vec4};
 /// Vertices per task when running on the rayon pool: large enough to amortise a task,
 /// small enough (≈ 200 KB of streams) to balance two to a few dozen threads.
 pub const PARALLEL_CHUNK: usize = 4096;
+const _: () = assert!(
+    PARALLEL_CHUNK.is_multiple_of(INFLUENCE_BLOCK),
+    "spans split at block boundaries"
+);
 
 /// The sign bit of an IEEE 754 single.
 const SIGN_BIT: u32 = 0x8000_0000;
@@ -122,6 +126,7 @@ impl SkinningJob<'_> {
         let span = Span {
             joints: self.skin.joints(),
             weights: self.skin.weights(),
+            block_influences: self.skin.block_influences(),
             rest_positions: self.rest_positions,
             rest_normals: self.rest_normals.unwrap_or_default(),
             rest_tangents: self.rest_tangents.unwrap_or_default(),
@@ -246,6 +251,8 @@ impl Blend for DualQuat {
 pub(crate) struct Span<'a> {
     pub(crate) joints: &'a [u16],
     pub(crate) weights: &'a [f32],
+    /// [`CompactSkin::block_influences`] of the span, which starts at a block boundary.
+    pub(crate) block_influences: &'a [u32],
     pub(crate) rest_positions: &'a [Vec3],
     pub(crate) rest_normals: &'a [Vec3],
     pub(crate) rest_tangents: &'a [Vec4],
@@ -259,8 +266,27 @@ impl<'a> Span<'a> {
         self.out_positions.len()
     }
 
-    /// The first `mid` vertices and the rest (`k` influences per vertex).
+    /// The blocks of [`INFLUENCE_BLOCK`] vertices: each range with the influences its rows
+    /// use, at most `k`.
+    pub(crate) fn blocks(
+        &self,
+        k: usize,
+    ) -> impl Iterator<Item = (std::ops::Range<usize>, usize)> + use<'a> {
+        let count = self.len();
+        let blocks: &'a [u32] = self.block_influences;
+        blocks.iter().enumerate().map(move |(b, &used)| {
+            let start = b * INFLUENCE_BLOCK;
+            (
+                start..(start + INFLUENCE_BLOCK).min(count),
+                (used as usize).min(k),
+            )
+        })
+    }
+
+    /// The first `mid` vertices (a multiple of [`INFLUENCE_BLOCK`]) and the rest (`k`
+    /// influences per vertex).
     fn split_at(self, mid: usize, k: usize) -> (Span<'a>, Span<'a>) {
+        debug_assert!(mid.is_multiple_of(INFLUENCE_BLOCK));
         fn cut<T>(s: &[T], at: usize) -> (&[T], &[T]) {
             s.split_at(at.min(s.len()))
         }
@@ -270,6 +296,7 @@ impl<'a> Span<'a> {
         }
         let (joints_a, joints_b) = cut(self.joints, mid * k);
         let (weights_a, weights_b) = cut(self.weights, mid * (k - 1));
+        let (blocks_a, blocks_b) = cut(self.block_influences, mid / INFLUENCE_BLOCK);
         let (rest_p_a, rest_p_b) = cut(self.rest_positions, mid);
         let (rest_n_a, rest_n_b) = cut(self.rest_normals, mid);
         let (rest_t_a, rest_t_b) = cut(self.rest_tangents, mid);
@@ -280,6 +307,7 @@ impl<'a> Span<'a> {
             Span {
                 joints: joints_a,
                 weights: weights_a,
+                block_influences: blocks_a,
                 rest_positions: rest_p_a,
                 rest_normals: rest_n_a,
                 rest_tangents: rest_t_a,
@@ -290,6 +318,7 @@ impl<'a> Span<'a> {
             Span {
                 joints: joints_b,
                 weights: weights_b,
+                block_influences: blocks_b,
                 rest_positions: rest_p_b,
                 rest_normals: rest_n_b,
                 rest_tangents: rest_t_b,
@@ -422,6 +451,7 @@ mod tests {
         let span = Span {
             joints: skin.joints(),
             weights: skin.weights(),
+            block_influences: skin.block_influences(),
             rest_positions: rest,
             rest_normals: rest,
             rest_tangents: tangents,
