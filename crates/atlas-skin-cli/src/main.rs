@@ -3,6 +3,7 @@
 mod cmd;
 mod html;
 mod input;
+mod skinning_data;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;

@@ -102,3 +102,65 @@ fn pose_runs_on_the_demo_character() {
         "a random pose moved by {moved} only"
     );
 }
+
+/// `--write-data` writes the side-by-side data file of ../shared/perf/README.md (header,
+/// then 48 bytes per vertex and 64 per joint), `--batch` times samples of several frames,
+/// `--instruction-set` picks the loops (the portable ones run on every CPU); a folder as
+/// the data file and an unknown instruction set are refused with their names.
+#[test]
+fn bench_writes_side_by_side_data() {
+    let data = test_file("bench_cli", "demo.bin");
+    let text = atlas_skin(&[
+        "bench",
+        "--json",
+        "--frames",
+        "2",
+        "--batch",
+        "3",
+        "--instruction-set",
+        "portable",
+        "--write-data",
+        data.to_str().expect("UTF-8 path"),
+    ]);
+    let report: Value = serde_json::from_str(&text).expect("one JSON object");
+    assert_eq!(report["batch"], 3, "{report}");
+    assert_eq!(report["instruction_set"], "portable", "{report}");
+    assert_eq!(report["allocations_per_frame"], 0.0, "{report}");
+    let bytes = std::fs::read(&data).expect("data file written");
+    let int = |at: usize| i32::from_le_bytes(bytes[at..at + 4].try_into().expect("4 bytes"));
+    let (vertices, joints) = (int(0) as usize, int(4) as usize);
+    assert_eq!(
+        vertices,
+        report["vertices"].as_u64().expect("vertices") as usize
+    );
+    assert!(joints > 10, "{joints} joints");
+    assert_eq!(bytes.len(), 8 + 48 * vertices + 64 * joints);
+    let weights = 8 + 32 * vertices;
+    for v in 0..vertices {
+        let row: f32 = (0..4)
+            .map(|i| {
+                let at = weights + 16 * v + 4 * i;
+                f32::from_le_bytes(bytes[at..at + 4].try_into().expect("4 bytes"))
+            })
+            .sum();
+        assert!((row - 1.0).abs() < 1e-5, "vertex {v}: weights sum to {row}");
+    }
+    let folder = support::out_dir("bench_cli_folder");
+    let failed = support::atlas_skin(&[
+        "bench",
+        "--frames",
+        "1",
+        "--write-data",
+        folder.to_str().expect("UTF-8 path"),
+    ]);
+    assert!(!failed.status.success());
+    let message = String::from_utf8_lossy(&failed.stderr);
+    assert!(
+        message.contains(folder.to_str().expect("UTF-8 path")),
+        "{message}"
+    );
+    let failed = support::atlas_skin(&["bench", "--frames", "1", "--instruction-set", "sse9"]);
+    assert!(!failed.status.success());
+    let message = String::from_utf8_lossy(&failed.stderr);
+    assert!(message.contains("\"sse9\""), "{message}");
+}

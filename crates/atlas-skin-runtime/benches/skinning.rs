@@ -1,11 +1,13 @@
 //! Linear blend and dual quaternion skinning throughput: positions and normals, 4
-//! influences per vertex, 1 and 2 threads, 1k to 1M vertices.
+//! influences per vertex, 1 and 2 threads, 1k to 1M vertices; and each instruction set
+//! this CPU runs on 15k vertices, one thread.
 //!
 //! `cargo bench -p atlas-skin-runtime --bench skinning`
 
 use atlas_skin_runtime::random_pose::{random_rotations, SplitMix64};
 use atlas_skin_runtime::{
-    CompactSkin, SkinningJob, SkinningMethod, SkinningPalette, Threading, VertexWeights,
+    CompactSkin, InstructionSet, SkinningJob, SkinningMethod, SkinningPalette, Threading,
+    VertexWeights,
 };
 use divan::{counter::ItemsCount, Bencher};
 use glam::{Mat4, Vec3};
@@ -53,7 +55,13 @@ impl Scene {
     }
 }
 
-fn skin(bencher: Bencher, count: usize, method: SkinningMethod, threads: usize) {
+fn skin(
+    bencher: Bencher,
+    count: usize,
+    method: SkinningMethod,
+    threads: usize,
+    set: InstructionSet,
+) {
     let scene = Scene::new(count);
     let mut palette = SkinningPalette::new(JOINTS);
     palette
@@ -83,7 +91,7 @@ fn skin(bencher: Bencher, count: usize, method: SkinningMethod, threads: usize) 
                 out_normals: Some(&mut out_normals),
                 out_tangents: None,
             }
-            .run()
+            .run_with(set)
             .expect("valid job")
         })
     });
@@ -91,10 +99,43 @@ fn skin(bencher: Bencher, count: usize, method: SkinningMethod, threads: usize) 
 
 #[divan::bench(args = SIZES, consts = [1, 2])]
 fn linear_blend<const THREADS: usize>(bencher: Bencher, count: usize) {
-    skin(bencher, count, SkinningMethod::LinearBlend, THREADS);
+    skin(
+        bencher,
+        count,
+        SkinningMethod::LinearBlend,
+        THREADS,
+        InstructionSet::best(),
+    );
 }
 
 #[divan::bench(args = SIZES, consts = [1, 2])]
 fn dual_quaternion<const THREADS: usize>(bencher: Bencher, count: usize) {
-    skin(bencher, count, SkinningMethod::DualQuaternion, THREADS);
+    skin(
+        bencher,
+        count,
+        SkinningMethod::DualQuaternion,
+        THREADS,
+        InstructionSet::best(),
+    );
+}
+
+/// The instruction sets this CPU runs, by name.
+fn supported_sets() -> Vec<&'static str> {
+    InstructionSet::ALL
+        .into_iter()
+        .filter(|set| set.is_supported())
+        .map(InstructionSet::name)
+        .collect()
+}
+
+#[divan::bench(args = supported_sets())]
+fn linear_blend_by_instruction_set(bencher: Bencher, set: &str) {
+    let set = InstructionSet::from_name(set).expect("a supported set");
+    skin(bencher, 15_000, SkinningMethod::LinearBlend, 1, set);
+}
+
+#[divan::bench(args = supported_sets())]
+fn dual_quaternion_by_instruction_set(bencher: Bencher, set: &str) {
+    let set = InstructionSet::from_name(set).expect("a supported set");
+    skin(bencher, 15_000, SkinningMethod::DualQuaternion, 1, set);
 }

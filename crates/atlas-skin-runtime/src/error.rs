@@ -60,6 +60,10 @@ pub enum RuntimeError {
         source_joint: String,
         target_joint: String,
     },
+    #[error(
+        "instruction set {name:?} is unknown or not supported by this CPU (portable, avx2, avx512)"
+    )]
+    UnsupportedInstructionSet { name: String },
     #[error("the joint map names {name:?}, which is not a joint of the {rig}")]
     UnknownMappedJoint { name: String, rig: &'static str },
 }

@@ -9,6 +9,7 @@ pub mod animation;
 pub mod compact_skin;
 pub mod dual_quaternion;
 pub mod error;
+pub mod instruction_set;
 pub mod pose;
 pub mod random_pose;
 pub mod reference;
@@ -18,6 +19,8 @@ pub mod sampling;
 pub mod skeleton;
 #[cfg(target_arch = "x86_64")]
 mod skinning_avx2;
+#[cfg(target_arch = "x86_64")]
+mod skinning_avx512;
 pub mod skinning_job;
 pub mod skinning_palette;
 pub mod weights;
@@ -26,6 +29,7 @@ pub use animation::{Clip, Interpolation, Property, Rig, Track, Trs};
 pub use compact_skin::CompactSkin;
 pub use dual_quaternion::DualQuat;
 pub use error::RuntimeError;
+pub use instruction_set::InstructionSet;
 pub use skeleton::{Skeleton, NO_PARENT};
 pub use skinning_job::{SkinningJob, Threading};
 pub use skinning_palette::{SkinningMethod, SkinningPalette};

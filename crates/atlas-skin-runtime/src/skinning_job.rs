@@ -1,8 +1,9 @@
 //! Deforming a mesh by a palette: linear blend and dual quaternion skinning over
 //! caller-owned buffers (the shape of ozz-animation's SkinningJob).
 
-use crate::compact_skin::CompactSkin;
+use crate::compact_skin::{CompactSkin, INFLUENCE_BLOCK};
 use crate::dual_quaternion::DualQuat;
+use crate::instruction_set::InstructionSet;
 use crate::skinning_palette::{SkinningMethod, SkinningPalette};
 use crate::RuntimeError;
 use glam::{Mat4, Quat, Vec3, Vec4};
@@ -10,6 +11,10 @@ use glam::{Mat4, Quat, Vec3, Vec4};
 /// Vertices per task when running on the rayon pool: large enough to amortise a task,
 /// small enough (≈ 200 KB of streams) to balance two to a few dozen threads.
 pub const PARALLEL_CHUNK: usize = 4096;
+const _: () = assert!(
+    PARALLEL_CHUNK.is_multiple_of(INFLUENCE_BLOCK),
+    "spans split at block boundaries"
+);
 
 /// The sign bit of an IEEE 754 single.
 const SIGN_BIT: u32 = 0x8000_0000;
@@ -43,9 +48,10 @@ pub enum Threading {
 /// [`SkinningJob::run`] checks only buffer lengths (O(1)); the skin and the palette were
 /// validated when built, and the loop then trusts them and allocates nothing.
 ///
-/// The loop is specialised per influence count and stream set; on x86-64 CPUs with AVX2
-/// and FMA (detected at run time) it uses those instructions, elsewhere portable glam
-/// code; both do the same arithmetic in the same order.
+/// The loop is specialised per influence count and stream set, and comes in the
+/// [`InstructionSet`] families: [`SkinningJob::run`] takes the widest this CPU runs
+/// (detected at run time), [`SkinningJob::run_with`] the one given. All do the same sums
+/// in the same order; they differ by round-off (fused multiply-adds).
 #[derive(Debug)]
 pub struct SkinningJob<'a> {
     pub skin: &'a CompactSkin,
@@ -100,12 +106,27 @@ impl SkinningJob<'_> {
         Ok(())
     }
 
-    /// Validates, then deforms every vertex into the output buffers.
+    /// Validates, then deforms every vertex into the output buffers with the widest
+    /// loops this CPU runs ([`InstructionSet::best`]).
     pub fn run(&mut self) -> Result<(), RuntimeError> {
+        self.run_with(InstructionSet::best())
+    }
+
+    /// As [`SkinningJob::run`], with the loops of `set`.
+    ///
+    /// Errors: [`RuntimeError::UnsupportedInstructionSet`] when this CPU lacks `set`, and
+    /// those of [`SkinningJob::validate`].
+    pub fn run_with(&mut self, set: InstructionSet) -> Result<(), RuntimeError> {
+        if !set.is_supported() {
+            return Err(RuntimeError::UnsupportedInstructionSet {
+                name: set.name().to_string(),
+            });
+        }
         self.validate()?;
         let span = Span {
             joints: self.skin.joints(),
             weights: self.skin.weights(),
+            block_influences: self.skin.block_influences(),
             rest_positions: self.rest_positions,
             rest_normals: self.rest_normals.unwrap_or_default(),
             rest_tangents: self.rest_tangents.unwrap_or_default(),
@@ -117,10 +138,10 @@ impl SkinningJob<'_> {
         let threading = self.threading;
         match self.palette.method() {
             SkinningMethod::LinearBlend => {
-                dispatch(self.palette.matrices(), k, threading, span);
+                dispatch(self.palette.matrices(), k, threading, span, set);
             }
             SkinningMethod::DualQuaternion => {
-                dispatch(self.palette.dual_quaternions(), k, threading, span);
+                dispatch(self.palette.dual_quaternions(), k, threading, span, set);
             }
         }
         Ok(())
@@ -132,8 +153,14 @@ trait Blend: Copy + Send + Sync {
     /// Blends the transforms of `joints` with weights `explicit` (#joints − 1 of them; the
     /// last is `1 − Σ explicit`).
     fn blend(palette: &[Self], joints: &[u16], explicit: &[f32]) -> Mat4;
-    /// A loop using this CPU's vector instructions, when there is one.
-    fn simd_kernel(k: usize, normals: bool, tangents: bool) -> Option<Kernel<Self>>;
+    /// The vector loop of `set` (a supported family), or of the next narrower family
+    /// when `set` has none for this case; `None` for the portable loop.
+    fn simd_kernel(
+        set: InstructionSet,
+        k: usize,
+        normals: bool,
+        tangents: bool,
+    ) -> Option<Kernel<Self>>;
 }
 
 impl Blend for Mat4 {
@@ -152,9 +179,21 @@ impl Blend for Mat4 {
         blended + palette[usize::from(joints[last])] * (1.0 - sum)
     }
 
-    fn simd_kernel(k: usize, normals: bool, tangents: bool) -> Option<Kernel<Self>> {
+    fn simd_kernel(
+        set: InstructionSet,
+        k: usize,
+        normals: bool,
+        tangents: bool,
+    ) -> Option<Kernel<Self>> {
         #[cfg(target_arch = "x86_64")]
-        return crate::skinning_avx2::linear_blend_kernel(k, normals, tangents);
+        return match set {
+            InstructionSet::Portable => None,
+            InstructionSet::Avx2 => crate::skinning_avx2::linear_blend_kernel(k, normals, tangents),
+            InstructionSet::Avx512 => {
+                crate::skinning_avx512::linear_blend_kernel(k, normals, tangents)
+                    .or_else(|| crate::skinning_avx2::linear_blend_kernel(k, normals, tangents))
+            }
+        };
         #[cfg(not(target_arch = "x86_64"))]
         return None;
     }
@@ -189,9 +228,19 @@ impl Blend for DualQuat {
         DualQuat { real, dual }.normalized_matrix()
     }
 
-    fn simd_kernel(k: usize, normals: bool, tangents: bool) -> Option<Kernel<Self>> {
+    fn simd_kernel(
+        set: InstructionSet,
+        k: usize,
+        normals: bool,
+        tangents: bool,
+    ) -> Option<Kernel<Self>> {
         #[cfg(target_arch = "x86_64")]
-        return crate::skinning_avx2::dual_quaternion_kernel(k, normals, tangents);
+        return match set {
+            InstructionSet::Portable => None,
+            InstructionSet::Avx2 | InstructionSet::Avx512 => {
+                crate::skinning_avx2::dual_quaternion_kernel(k, normals, tangents)
+            }
+        };
         #[cfg(not(target_arch = "x86_64"))]
         return None;
     }
@@ -202,6 +251,8 @@ impl Blend for DualQuat {
 pub(crate) struct Span<'a> {
     pub(crate) joints: &'a [u16],
     pub(crate) weights: &'a [f32],
+    /// [`CompactSkin::block_influences`] of the span, which starts at a block boundary.
+    pub(crate) block_influences: &'a [u32],
     pub(crate) rest_positions: &'a [Vec3],
     pub(crate) rest_normals: &'a [Vec3],
     pub(crate) rest_tangents: &'a [Vec4],
@@ -215,8 +266,27 @@ impl<'a> Span<'a> {
         self.out_positions.len()
     }
 
-    /// The first `mid` vertices and the rest (`k` influences per vertex).
+    /// The blocks of [`INFLUENCE_BLOCK`] vertices: each range with the influences its rows
+    /// use, at most `k`.
+    pub(crate) fn blocks(
+        &self,
+        k: usize,
+    ) -> impl Iterator<Item = (std::ops::Range<usize>, usize)> + use<'a> {
+        let count = self.len();
+        let blocks: &'a [u32] = self.block_influences;
+        blocks.iter().enumerate().map(move |(b, &used)| {
+            let start = b * INFLUENCE_BLOCK;
+            (
+                start..(start + INFLUENCE_BLOCK).min(count),
+                (used as usize).min(k),
+            )
+        })
+    }
+
+    /// The first `mid` vertices (a multiple of [`INFLUENCE_BLOCK`]) and the rest (`k`
+    /// influences per vertex).
     fn split_at(self, mid: usize, k: usize) -> (Span<'a>, Span<'a>) {
+        debug_assert!(mid.is_multiple_of(INFLUENCE_BLOCK));
         fn cut<T>(s: &[T], at: usize) -> (&[T], &[T]) {
             s.split_at(at.min(s.len()))
         }
@@ -226,6 +296,7 @@ impl<'a> Span<'a> {
         }
         let (joints_a, joints_b) = cut(self.joints, mid * k);
         let (weights_a, weights_b) = cut(self.weights, mid * (k - 1));
+        let (blocks_a, blocks_b) = cut(self.block_influences, mid / INFLUENCE_BLOCK);
         let (rest_p_a, rest_p_b) = cut(self.rest_positions, mid);
         let (rest_n_a, rest_n_b) = cut(self.rest_normals, mid);
         let (rest_t_a, rest_t_b) = cut(self.rest_tangents, mid);
@@ -236,6 +307,7 @@ impl<'a> Span<'a> {
             Span {
                 joints: joints_a,
                 weights: weights_a,
+                block_influences: blocks_a,
                 rest_positions: rest_p_a,
                 rest_normals: rest_n_a,
                 rest_tangents: rest_t_a,
@@ -246,6 +318,7 @@ impl<'a> Span<'a> {
             Span {
                 joints: joints_b,
                 weights: weights_b,
+                block_influences: blocks_b,
                 rest_positions: rest_p_b,
                 rest_normals: rest_n_b,
                 rest_tangents: rest_t_b,
@@ -286,12 +359,18 @@ macro_rules! specialise {
 }
 pub(crate) use specialise;
 
-/// Picks the loop for the influence count and streams: the CPU's vector loop when there
-/// is one, else the portable loop ([`skin_span`]).
-fn dispatch<B: Blend>(palette: &[B], k: usize, threading: Threading, span: Span) {
+/// Picks the loop for the influence count and streams: the vector loop of `set` when
+/// there is one, else the portable loop ([`skin_span`]).
+fn dispatch<B: Blend>(
+    palette: &[B],
+    k: usize,
+    threading: Threading,
+    span: Span,
+    set: InstructionSet,
+) {
     let normals = !span.out_normals.is_empty();
     let tangents = !span.out_tangents.is_empty();
-    let kernel = B::simd_kernel(k, normals, tangents)
+    let kernel = B::simd_kernel(set, k, normals, tangents)
         .unwrap_or_else(|| portable_kernel::<B>(k, normals, tangents));
     match threading {
         Threading::Sequential => kernel(palette, k, span),
@@ -372,6 +451,7 @@ mod tests {
         let span = Span {
             joints: skin.joints(),
             weights: skin.weights(),
+            block_influences: skin.block_influences(),
             rest_positions: rest,
             rest_normals: rest,
             rest_tangents: tangents,
@@ -383,8 +463,8 @@ mod tests {
         (p, nn, t)
     }
 
-    /// The CPU's vector loops (when present) and the portable loops agree to round-off
-    /// for every influence count and both methods.
+    /// Every instruction set's loops this CPU runs and the portable loops agree to
+    /// round-off for every influence count and both methods.
     #[test]
     fn vector_and_portable_loops_agree() {
         let mut rng = SplitMix64::new(11);
@@ -410,7 +490,10 @@ mod tests {
                     .collect::<Vec<_>>()
             }));
             let skin = CompactSkin::new(&weights, joints, k).unwrap();
-            for method in [SkinningMethod::LinearBlend, SkinningMethod::DualQuaternion] {
+            let sets = InstructionSet::ALL.into_iter().filter(|s| s.is_supported());
+            for (method, set) in sets.flat_map(|set| {
+                [SkinningMethod::LinearBlend, SkinningMethod::DualQuaternion].map(|m| (m, set))
+            }) {
                 let mut palette = SkinningPalette::new(joints);
                 palette.update(&matrices, method).unwrap();
                 let n = rest.len();
@@ -430,7 +513,7 @@ mod tests {
                     out_normals: Some(&mut nn),
                     out_tangents: Some(&mut t),
                 }
-                .run()
+                .run_with(set)
                 .unwrap();
                 let expected = match method {
                     SkinningMethod::LinearBlend => {
@@ -443,15 +526,15 @@ mod tests {
                 for v in 0..n {
                     assert!(
                         p[v].abs_diff_eq(expected.0[v], 1e-5),
-                        "k {k} {method:?} position {v}"
+                        "k {k} {method:?} {set:?} position {v}"
                     );
                     assert!(
                         nn[v].abs_diff_eq(expected.1[v], 1e-5),
-                        "k {k} {method:?} normal {v}"
+                        "k {k} {method:?} {set:?} normal {v}"
                     );
                     assert!(
                         t[v].abs_diff_eq(expected.2[v], 1e-5),
-                        "k {k} {method:?} tangent {v}"
+                        "k {k} {method:?} {set:?} tangent {v}"
                     );
                 }
             }

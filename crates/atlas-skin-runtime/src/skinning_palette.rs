@@ -20,12 +20,18 @@ pub enum SkinningMethod {
     DualQuaternion,
 }
 
+/// A palette matrix on a cache line of its own: a 64-byte `Mat4` at a 64-byte boundary, so
+/// that a 512-bit load of it (or two 256-bit loads) never straddles two lines.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(C, align(64))]
+struct CacheLineMat4(Mat4);
+
 /// A skinning palette (`world[j] · inverse_bind[j]` per joint) prepared for a
 /// [`crate::skinning_job::SkinningJob`]: sized once for #J joints, then refilled every
 /// frame by [`SkinningPalette::update`] without allocating.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SkinningPalette {
-    matrices: Vec<Mat4>,
+    matrices: Vec<CacheLineMat4>,
     dual_quaternions: Vec<DualQuat>,
     method: SkinningMethod,
 }
@@ -34,7 +40,7 @@ impl SkinningPalette {
     /// A palette of `joint_count` identity transforms, ready for either method.
     pub fn new(joint_count: usize) -> Self {
         Self {
-            matrices: vec![Mat4::IDENTITY; joint_count],
+            matrices: vec![CacheLineMat4(Mat4::IDENTITY); joint_count],
             dual_quaternions: vec![DualQuat::from_rigid(&Mat4::IDENTITY); joint_count],
             method: SkinningMethod::DualQuaternion,
         }
@@ -70,7 +76,9 @@ impl SkinningPalette {
                 });
             }
         }
-        self.matrices.copy_from_slice(palette);
+        for (slot, m) in self.matrices.iter_mut().zip(palette) {
+            slot.0 = *m;
+        }
         self.method = method;
         if method == SkinningMethod::DualQuaternion {
             for (joint, (m, dq)) in palette.iter().zip(&mut self.dual_quaternions).enumerate() {
@@ -96,9 +104,14 @@ impl SkinningPalette {
         self.method
     }
 
-    /// #J matrices.
+    /// #J matrices, each at a 64-byte boundary.
     pub fn matrices(&self) -> &[Mat4] {
-        &self.matrices
+        const _: () = assert!(std::mem::size_of::<CacheLineMat4>() == std::mem::size_of::<Mat4>());
+        // SAFETY: `CacheLineMat4` is `repr(C)` around one `Mat4` and, as asserted, adds no
+        // padding, so #J of them are #J consecutive `Mat4`s (whose alignment, 16, 64 meets).
+        unsafe {
+            std::slice::from_raw_parts(self.matrices.as_ptr().cast::<Mat4>(), self.matrices.len())
+        }
     }
 
     /// #J unit dual quaternions (valid after an update for dual quaternion skinning).

@@ -6,8 +6,8 @@ use atlas_skin_runtime::reference::{
     linear_blend_vectors,
 };
 use atlas_skin_runtime::{
-    CompactSkin, RuntimeError, SkinningJob, SkinningMethod, SkinningPalette, Threading,
-    VertexWeights,
+    CompactSkin, InstructionSet, RuntimeError, SkinningJob, SkinningMethod, SkinningPalette,
+    Threading, VertexWeights,
 };
 use glam::{Mat4, Quat, Vec3, Vec4};
 use proptest::prelude::*;
@@ -20,7 +20,17 @@ struct Posed {
     tangents: Vec<Vec4>,
 }
 
+/// Every instruction set this CPU runs, the portable one first.
+fn supported_sets() -> Vec<InstructionSet> {
+    InstructionSet::ALL
+        .into_iter()
+        .filter(|s| s.is_supported())
+        .collect()
+}
+
+#[allow(clippy::too_many_arguments)]
 fn run_job(
+    set: InstructionSet,
     skin: &CompactSkin,
     matrices: &[Mat4],
     method: SkinningMethod,
@@ -52,7 +62,7 @@ fn run_job(
         out_normals: Some(&mut posed.normals),
         out_tangents: with_tangents.then_some(posed.tangents.as_mut_slice()),
     }
-    .run()?;
+    .run_with(set)?;
     Ok(posed)
 }
 
@@ -92,8 +102,9 @@ fn weights_strategy(vertices: usize, joints: u32) -> impl Strategy<Value = Verte
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
-    /// Every specialisation (K = 1…4 and N, sequential and parallel) matches the scalar
-    /// reference within 1e-5 of the bounding-box diagonal.
+    /// Every specialisation (K = 1…4 and N, sequential and parallel, every instruction set
+    /// this CPU runs) matches the scalar reference within 1e-5 of the bounding-box
+    /// diagonal.
     #[test]
     fn fast_paths_match_the_reference(
         rows in weights_strategy(300, 6),
@@ -112,9 +123,9 @@ proptest! {
         let mut expected_p = vec![Vec3::ZERO; rest.len()];
         let mut expected_n = vec![Vec3::ZERO; rest.len()];
         let tolerance = 1e-5 * diagonal(&rest);
-        for tangents in [false, true] {
+        for (tangents, set) in [false, true].into_iter().flat_map(|t| supported_sets().into_iter().map(move |s| (t, s))) {
             for method in [SkinningMethod::LinearBlend, SkinningMethod::DualQuaternion] {
-                let posed = run_job(&skin, &matrices, method, threading, &rest, &normals, tangents).unwrap();
+                let posed = run_job(set, &skin, &matrices, method, threading, &rest, &normals, tangents).unwrap();
                 match method {
                     SkinningMethod::LinearBlend => {
                         linear_blend_positions(&rest, &reference_weights, &matrices, &mut expected_p);
@@ -125,8 +136,8 @@ proptest! {
                         dual_quaternion_vectors(&normals, &reference_weights, &matrices, &mut expected_n);
                     }
                 }
-                prop_assert!(max_distance(&posed.positions, &expected_p) <= tolerance, "{method:?} positions, tangents: {tangents}");
-                prop_assert!(max_distance(&posed.normals, &expected_n) <= 1e-5, "{method:?} normals, tangents: {tangents}");
+                prop_assert!(max_distance(&posed.positions, &expected_p) <= tolerance, "{method:?} {set:?} positions, tangents: {tangents}");
+                prop_assert!(max_distance(&posed.normals, &expected_n) <= 1e-5, "{method:?} {set:?} normals, tangents: {tangents}");
             }
         }
     }
@@ -142,8 +153,8 @@ proptest! {
         let normals: Vec<Vec3> = rest.iter().map(|p| p.normalize_or(Vec3::Z)).collect();
         let skin = CompactSkin::new(&rows, 5, max_influences).unwrap();
         for method in [SkinningMethod::LinearBlend, SkinningMethod::DualQuaternion] {
-            for tangents in [false, true] {
-                let posed = run_job(&skin, &[Mat4::IDENTITY; 5], method, Threading::Sequential, &rest, &normals, tangents).unwrap();
+            for (tangents, set) in [false, true].into_iter().flat_map(|t| supported_sets().into_iter().map(move |s| (t, s))) {
+                let posed = run_job(set, &skin, &[Mat4::IDENTITY; 5], method, Threading::Sequential, &rest, &normals, tangents).unwrap();
                 prop_assert_eq!(&posed.positions, &rest);
                 prop_assert_eq!(&posed.normals, &normals);
             }
@@ -162,6 +173,7 @@ fn one_rigid_joint_moves_the_mesh_rigidly() {
     let moved = rigid([0.3, -0.2, 0.9, 0.5], [1.0, 2.0, -3.0]);
     for method in [SkinningMethod::LinearBlend, SkinningMethod::DualQuaternion] {
         let posed = run_job(
+            InstructionSet::best(),
             &skin,
             &[Mat4::IDENTITY, moved],
             method,
@@ -200,6 +212,7 @@ fn candy_wrapper_dqs_keeps_edge_lengths_lbs_shrinks_them() {
     let twist = Mat4::from_rotation_x(150f32.to_radians());
     let edge = |p: &[Vec3], i: usize| p[i].distance(p[(i + 1) % ring]);
     let lbs = run_job(
+        InstructionSet::best(),
         &skin,
         &[Mat4::IDENTITY, twist],
         SkinningMethod::LinearBlend,
@@ -210,6 +223,7 @@ fn candy_wrapper_dqs_keeps_edge_lengths_lbs_shrinks_them() {
     )
     .unwrap();
     let dqs = run_job(
+        InstructionSet::best(),
         &skin,
         &[Mat4::IDENTITY, twist],
         SkinningMethod::DualQuaternion,
@@ -294,6 +308,7 @@ fn parallel_run_equals_sequential_run_bit_for_bit() {
     ];
     for method in [SkinningMethod::LinearBlend, SkinningMethod::DualQuaternion] {
         let sequential = run_job(
+            InstructionSet::best(),
             &skin,
             &matrices,
             method,
@@ -304,6 +319,7 @@ fn parallel_run_equals_sequential_run_bit_for_bit() {
         )
         .unwrap();
         let parallel = run_job(
+            InstructionSet::best(),
             &skin,
             &matrices,
             method,

@@ -8,21 +8,30 @@
 //!
 //! The copy moves as many bytes as a frame reads and writes, on the same thread pool, in
 //! as many tasks as the skinning job, so that both see the same caches (a mesh that fits
-//! in cache is compared with a copy that fits too). The machine is shared: frames of
+//! in cache is compared with a copy that fits too). The machine is shared: samples of
 //! both methods and copies are interleaved, so that every figure sees the same load, and
-//! each figure is the median of its frames.
+//! each figure is the median of its samples. A sample is one frame by default, or
+//! `--batch` consecutive frames (what `scripts/bench-vs-ozz` uses to time atlas-skin as
+//! ozz-animation's program times itself: samples of about 0.15 s, which include the
+//! machine's other work as a frame of 60 µs rarely does).
+//!
+//! `--write-data` writes the benchmark's skinning data for a peer's program
+//! ([`crate::skinning_data`]).
 
 use super::pose::{Posable, POSE_INFLUENCES};
 use crate::input::InputArgs;
+use crate::skinning_data;
 use anyhow::{ensure, Context, Result};
 use atlas_skin_runtime::random_pose::random_rotations;
 use atlas_skin_runtime::skinning_job::PARALLEL_CHUNK;
 use atlas_skin_runtime::{
-    CompactSkin, SkinningJob, SkinningMethod, SkinningPalette, Threading, VertexWeights,
+    CompactSkin, InstructionSet, SkinningJob, SkinningMethod, SkinningPalette, Threading,
+    VertexWeights,
 };
 use glam::{Mat4, Vec3};
 use rayon::prelude::*;
 use std::alloc::{GlobalAlloc, Layout, System};
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
@@ -71,20 +80,36 @@ pub struct Args {
     /// Replicate the mesh to this many vertices (default: the mesh as is).
     #[arg(long)]
     pub vertices: Option<usize>,
-    /// Frames timed per method.
+    /// Timed samples per method.
     #[arg(long, default_value_t = 200)]
     pub frames: usize,
+    /// Consecutive frames in one timed sample (1: every frame timed on its own; the
+    /// side-by-side runner times samples of about 0.15 s, as ozz-animation's program does,
+    /// so that both see the machine's load alike).
+    #[arg(long, default_value_t = 1)]
+    pub batch: usize,
+    /// The skinning loops: portable, avx2 or avx512 (default: the widest this CPU runs).
+    #[arg(long, value_name = "NAME")]
+    pub instruction_set: Option<String>,
     /// Print the figures as one JSON object.
     #[arg(long)]
     pub json: bool,
+    /// Also write the benchmark's skinning data (rest positions and normals, 4
+    /// influences, the first pose's palette) for a peer's skinning job, in the format of
+    /// `../shared/perf/README.md` (what `scripts/bench-vs-ozz` hands to ozz-animation).
+    #[arg(long, value_name = "DATA.bin")]
+    pub write_data: Option<PathBuf>,
 }
 
-/// What one run measures: rates from the median frame, bandwidth from the median copy.
+/// What one run measures: rates from the median sample, bandwidth from the median copy.
 #[derive(Debug, serde::Serialize)]
 pub struct BenchReport {
     pub vertices: usize,
     pub threads: usize,
     pub frames: usize,
+    pub batch: usize,
+    /// The skinning loops that ran ([`InstructionSet::name`]).
+    pub instruction_set: &'static str,
     pub influences: usize,
     pub lbs_vertices_per_second: f64,
     pub dqs_vertices_per_second: f64,
@@ -102,6 +127,11 @@ pub struct BenchReport {
 pub fn run(args: Args) -> Result<()> {
     ensure!(args.threads >= 1, "--threads must be at least 1");
     ensure!(args.frames >= 1, "--frames must be at least 1");
+    ensure!(args.batch >= 1, "--batch must be at least 1");
+    let set = match &args.instruction_set {
+        Some(name) => InstructionSet::from_name(name)?,
+        None => InstructionSet::best(),
+    };
     let character = args.input.load_skinned()?;
     let posable = Posable::new(&character)?;
     let weights = character
@@ -120,6 +150,16 @@ pub fn run(args: Args) -> Result<()> {
             )))
         })
         .collect();
+    if let Some(out) = &args.write_data {
+        skinning_data::write(
+            out,
+            args.input.input.as_deref(),
+            &streams.skin,
+            &streams.rest_positions,
+            &streams.rest_normals,
+            &palettes[0],
+        )?;
+    }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads)
         .build()
@@ -129,8 +169,16 @@ pub fn run(args: Args) -> Result<()> {
     } else {
         Threading::Parallel
     };
-    let timings = pool.install(|| measure(&mut streams, &palettes, threading, args.frames))?;
-    let frames = args.frames as f64;
+    let timings = pool.install(|| {
+        measure(
+            &mut streams,
+            &palettes,
+            (threading, set),
+            args.frames,
+            args.batch,
+        )
+    })?;
+    let frames = (args.frames * args.batch) as f64;
     let lbs_rate = count as f64 / timings.lbs;
     let dqs_rate = count as f64 / timings.dqs;
     let copy_bandwidth = streams.copy_bytes() as f64 / timings.copy;
@@ -139,6 +187,8 @@ pub fn run(args: Args) -> Result<()> {
         vertices: count,
         threads: args.threads,
         frames: args.frames,
+        batch: args.batch,
+        instruction_set: set.name(),
         influences: streams.skin.influences(),
         lbs_vertices_per_second: lbs_rate,
         dqs_vertices_per_second: dqs_rate,
@@ -158,8 +208,8 @@ pub fn run(args: Args) -> Result<()> {
 
 fn print_report(r: &BenchReport) {
     println!(
-        "{} vertices, {} influences, {} thread(s), {} frames per method",
-        r.vertices, r.influences, r.threads, r.frames
+        "{} vertices, {} influences, {} thread(s), {} loops, {} samples of {} frame(s) per method",
+        r.vertices, r.influences, r.threads, r.instruction_set, r.frames, r.batch
     );
     println!(
         "linear blend:    {:8.1} M vertices/s ({:.0}% of copy bandwidth)",
@@ -224,43 +274,49 @@ impl Streams {
         2 * std::mem::size_of_val(self.copy_source.as_slice())
     }
 
-    /// Seconds to prepare `palette` for `pose` and skin every vertex with it.
-    fn skin_frame(
+    /// Seconds per frame of `poses.len()` frames, each preparing `palette` for its pose
+    /// and skinning every vertex with it.
+    fn skin_frames<'p>(
         &mut self,
         palette: &mut SkinningPalette,
-        pose: &[Mat4],
+        poses: impl ExactSizeIterator<Item = &'p Vec<Mat4>>,
         method: SkinningMethod,
-        threading: Threading,
+        (threading, set): (Threading, InstructionSet),
     ) -> Result<f64> {
+        let count = poses.len() as f64;
         let start = Instant::now();
-        palette
-            .update(pose, method)
-            .context("cannot skin the benchmark pose")?;
-        SkinningJob {
-            skin: &self.skin,
-            palette,
-            threading,
-            rest_positions: &self.rest_positions,
-            rest_normals: Some(&self.rest_normals),
-            rest_tangents: None,
-            out_positions: &mut self.out_positions,
-            out_normals: Some(&mut self.out_normals),
-            out_tangents: None,
+        for pose in poses {
+            palette
+                .update(pose, method)
+                .context("cannot skin the benchmark pose")?;
+            SkinningJob {
+                skin: &self.skin,
+                palette,
+                threading,
+                rest_positions: &self.rest_positions,
+                rest_normals: Some(&self.rest_normals),
+                rest_tangents: None,
+                out_positions: &mut self.out_positions,
+                out_normals: Some(&mut self.out_normals),
+                out_tangents: None,
+            }
+            .run_with(set)?;
         }
-        .run()?;
-        Ok(start.elapsed().as_secs_f64())
+        Ok(start.elapsed().as_secs_f64() / count)
     }
 
-    /// Seconds to copy the copy source to the copy target on the current thread pool, in
-    /// as many tasks as a skinning job of the same vertices.
-    fn copy_pass(&mut self) -> f64 {
+    /// Seconds per pass of `passes` copies of the copy source to the copy target on the
+    /// current thread pool, each in as many tasks as a skinning job of the same vertices.
+    fn copy_passes(&mut self, passes: usize) -> f64 {
         let chunk = (PARALLEL_CHUNK * self.bytes_per_vertex() / 2).div_ceil(8);
         let start = Instant::now();
-        self.copy_target
-            .par_chunks_mut(chunk)
-            .zip(self.copy_source.par_chunks(chunk))
-            .for_each(|(target, source)| target.copy_from_slice(source));
-        start.elapsed().as_secs_f64()
+        for _ in 0..passes {
+            self.copy_target
+                .par_chunks_mut(chunk)
+                .zip(self.copy_source.par_chunks(chunk))
+                .for_each(|(target, source)| target.copy_from_slice(source));
+        }
+        start.elapsed().as_secs_f64() / passes as f64
     }
 }
 
@@ -280,14 +336,16 @@ struct Timings {
     allocations: u64,
 }
 
-/// Times `frames` rounds of: a linear blend frame, a dual quaternion frame (each a palette
-/// preparation plus skinning) and a copy of [`Streams::copy_bytes`], after one warm-up
-/// round (page faults of the first touch, thread start-up).
+/// Times `frames` rounds of: `batch` linear blend frames, `batch` dual quaternion frames
+/// (each a palette preparation plus skinning) and `batch` copies of
+/// [`Streams::copy_bytes`], after one warm-up round (page faults of the first touch,
+/// thread start-up).
 fn measure(
     streams: &mut Streams,
     palettes: &[Vec<Mat4>],
-    threading: Threading,
+    threading: (Threading, InstructionSet),
     frames: usize,
+    batch: usize,
 ) -> Result<Timings> {
     let joints = streams.skin.joint_count();
     let mut lbs_palette = SkinningPalette::new(joints);
@@ -295,22 +353,22 @@ fn measure(
     let mut seconds = [vec![0.0; frames], vec![0.0; frames], vec![0.0; frames]];
     let mut allocations = 0;
     for round in 0..=frames {
-        let pose = &palettes[round % palettes.len()];
+        let poses = || (round * batch..(round + 1) * batch).map(|f| &palettes[f % palettes.len()]);
         let before = ALLOCATIONS.load(Ordering::Relaxed);
-        let lbs = streams.skin_frame(
+        let lbs = streams.skin_frames(
             &mut lbs_palette,
-            pose,
+            poses(),
             SkinningMethod::LinearBlend,
             threading,
         )?;
-        let dqs = streams.skin_frame(
+        let dqs = streams.skin_frames(
             &mut dqs_palette,
-            pose,
+            poses(),
             SkinningMethod::DualQuaternion,
             threading,
         )?;
         let after = ALLOCATIONS.load(Ordering::Relaxed);
-        let copy = streams.copy_pass();
+        let copy = streams.copy_passes(batch);
         // Round 0 warms up.
         if let Some(previous) = round.checked_sub(1) {
             for (samples, s) in seconds.iter_mut().zip([lbs, dqs, copy]) {
