@@ -36,6 +36,18 @@ pub fn models_dir() -> PathBuf {
     data_dir().join("models")
 }
 
+/// The file `relative` of `../shared/data` (e.g. `fbx/KayKit_Knight.fbx`); panics when it
+/// is missing.
+pub fn data_file(relative: &str) -> PathBuf {
+    let path = data_dir().join(relative);
+    assert!(
+        path.is_file(),
+        "corpus file {} is missing (tests never skip)",
+        path.display()
+    );
+    path
+}
+
 /// The motion clip `file` of `../shared/data/motion` (e.g. `walk.bvh`); panics when it is
 /// missing.
 pub fn motion_path(file: &str) -> PathBuf {

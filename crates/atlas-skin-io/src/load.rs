@@ -3,20 +3,22 @@
 
 use crate::text::check_file;
 use crate::{
-    bvh, dmat, gltf, medit, mhskel, mhw, obj, off, ply, skeleton_json, stl, tgf, Character,
+    bvh, dmat, fbx, gltf, medit, mhskel, mhw, obj, off, ply, skeleton_json, stl, tgf, Character,
     IoError, LoadOptions, TriangleMesh,
 };
 use atlas_skin_runtime::{Rig, VertexWeights};
 use glam::Vec3;
 use std::path::Path;
 
-const MESH_EXTENSIONS: &str = ".glb, .gltf, .vrm, .obj, .mesh, .off, .ply or .stl";
+const MESH_EXTENSIONS: &str = ".glb, .gltf, .vrm, .fbx, .obj, .mesh, .off, .ply or .stl";
 const SKELETON_EXTENSIONS: &str = ".tgf, .bvh, .mhskel or .json";
 const WEIGHTS_EXTENSIONS: &str = ".dmat or .mhw";
 
 /// Reads the character at `path` with `options`.
 ///
 /// - `.glb`, `.gltf`, `.vrm`: mesh, skeleton, weights and animations from the document.
+/// - `.fbx`: skinned and rigid meshes, skeleton and weights, converted to glTF's units
+///   and axes ([`fbx::read`]).
 /// - `.obj`, `.mesh`, `.off`, `.ply`, `.stl`: a mesh; vertices no (kept) triangle uses are
 ///   dropped and [`Character::file_vertex`] maps the rest back to the file's numbering.
 /// - `options.skeleton` (`.tgf`, `.bvh`, `.mhskel`, `.json`) gives a mesh its skeleton;
@@ -34,7 +36,7 @@ pub fn load_character(path: &Path, options: &LoadOptions) -> Result<Character, I
         return Err(IoError::invalid(path, "--group applies to OBJ files only"));
     }
     let file_mesh = match extension.as_str() {
-        "glb" | "gltf" | "vrm" => None,
+        "glb" | "gltf" | "vrm" | "fbx" => None,
         "obj" => Some(obj::read(path, options.group.as_deref())?),
         "mesh" => Some(medit::read(path)?),
         "off" => Some(off::read(path)?),
@@ -45,7 +47,11 @@ pub fn load_character(path: &Path, options: &LoadOptions) -> Result<Character, I
     let (mut character, file_positions) = match file_mesh {
         Some(file_mesh) => (compacted_character(path, &file_mesh), file_mesh.positions),
         None => {
-            let character = gltf::read(path)?;
+            let character = if extension == "fbx" {
+                fbx::read(path)?
+            } else {
+                gltf::read(path)?
+            };
             let positions = character.mesh.positions.clone();
             (character, positions)
         }
