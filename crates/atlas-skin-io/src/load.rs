@@ -3,15 +3,15 @@
 
 use crate::text::check_file;
 use crate::{
-    bvh, dmat, fbx, gltf, medit, mhskel, mhw, obj, off, ply, skeleton_json, stl, tgf, Character,
-    IoError, LoadOptions, TriangleMesh,
+    bvh, dmat, fbx, gltf, medit, mhskel, mhw, obj, off, ply, rig_info, skeleton_json, stl, tgf,
+    Character, IoError, LoadOptions, TriangleMesh,
 };
 use atlas_skin_runtime::{Rig, VertexWeights};
 use glam::Vec3;
 use std::path::Path;
 
 const MESH_EXTENSIONS: &str = ".glb, .gltf, .vrm, .fbx, .obj, .mesh, .off, .ply or .stl";
-const SKELETON_EXTENSIONS: &str = ".tgf, .bvh, .mhskel or .json";
+const SKELETON_EXTENSIONS: &str = ".tgf, .bvh, .mhskel, .json or RigNet's _rig.txt";
 const WEIGHTS_EXTENSIONS: &str = ".dmat or .mhw";
 
 /// Reads the character at `path` with `options`.
@@ -21,8 +21,9 @@ const WEIGHTS_EXTENSIONS: &str = ".dmat or .mhw";
 ///   and axes ([`fbx::read`]).
 /// - `.obj`, `.mesh`, `.off`, `.ply`, `.stl`: a mesh; vertices no (kept) triangle uses are
 ///   dropped and [`Character::file_vertex`] maps the rest back to the file's numbering.
-/// - `options.skeleton` (`.tgf`, `.bvh`, `.mhskel`, `.json`) gives a mesh its skeleton;
-///   without one the character has none and a warning says so.
+/// - `options.skeleton` (`.tgf`, `.bvh`, `.mhskel`, `.json`, RigNet's `_rig.txt`) gives a
+///   mesh its skeleton; without one the character has none and a warning says so. A
+///   rig_info file's `skin` lines also give the reference weights.
 /// - `options.weights` (`.dmat`, `.mhw`) gives reference weights, one row per vertex of
 ///   the mesh file.
 ///
@@ -144,6 +145,14 @@ fn attach_skeleton(
         }
         "mhskel" => mhskel::read(path, file_positions)?,
         "json" => skeleton_json::read(path)?,
+        "txt" => {
+            let rig = rig_info::read(path, file_positions.len())?;
+            if let Some(weights) = &rig.weights {
+                character.reference_weights =
+                    Some(kept_rows(character, weights, path, rig.skeleton.len())?);
+            }
+            rig.skeleton
+        }
         other => return Err(unsupported(path, other.to_string(), SKELETON_EXTENSIONS)),
     };
     if skeleton.is_empty() {
@@ -154,6 +163,26 @@ fn attach_skeleton(
     }
     character.skeleton = Some(skeleton);
     Ok(bone_joints)
+}
+
+/// The rows of `file_weights` (one per vertex of the mesh file) of the character's kept
+/// vertices, checked against `joint_count` joints.
+fn kept_rows(
+    character: &Character,
+    file_weights: &VertexWeights,
+    path: &Path,
+    joint_count: usize,
+) -> Result<VertexWeights, IoError> {
+    let weights = VertexWeights::from_rows(
+        character
+            .file_vertex
+            .iter()
+            .map(|&v| file_weights.row(v as usize).collect::<Vec<_>>()),
+    );
+    weights
+        .validate(joint_count)
+        .map_err(|error| IoError::invalid(path, error.to_string()))?;
+    Ok(weights)
 }
 
 /// Reads the weights file into `character.reference_weights`: one row per vertex of the
@@ -206,15 +235,7 @@ fn attach_weights(
         "mhw" => mhw::read(path, skeleton, file_vertex_count)?,
         other => return Err(unsupported(path, other.to_string(), WEIGHTS_EXTENSIONS)),
     };
-    let weights = VertexWeights::from_rows(
-        character
-            .file_vertex
-            .iter()
-            .map(|&v| file_weights.row(v as usize).collect::<Vec<_>>()),
-    );
-    weights
-        .validate(skeleton.len())
-        .map_err(|error| IoError::invalid(path, error.to_string()))?;
+    let weights = kept_rows(character, &file_weights, path, skeleton.len())?;
     if character.reference_weights.is_some() {
         character.warnings.push(format!(
             "the input's own weights were replaced by {}",
