@@ -1,6 +1,7 @@
 //! Checks against Blender (the `bpy` package of PyPI, in the venv `scripts/install-test-deps`
 //! makes under target/bpy-venv): FBX characters posed by `atlas-skin pose` land where
-//! Blender's FBX import posed the same way puts them.
+//! Blender's FBX import posed the same way puts them, and `eval` takes Blender's bone-heat
+//! export of a glb (joints renamed, mesh baked into the scene's space).
 //!
 //! "The same way" does not depend on how each tool orients its bones: every joint turns by
 //! a rotation Q_j about its own head, in world axes, after its parent's. atlas-skin's pose
@@ -24,7 +25,7 @@ fn workspace() -> PathBuf {
 }
 
 /// Runs a script of tests/blender with the bpy venv's Python; panics with its stderr.
-pub fn run_blender(script: &str, args: &[&Path]) {
+fn run_blender(script: &str, args: &[&Path]) {
     let python = workspace().join("target/bpy-venv/bin/python");
     assert!(
         python.is_file(),
@@ -141,4 +142,50 @@ fn posed_fbx_characters_agree_with_blender() {
         eprintln!("{file}: largest difference {difference:.2e} of the diagonal");
         assert!(difference < 1e-4, "{file}: {difference}");
     }
+}
+
+#[test]
+fn eval_takes_a_blender_bone_heat_export_as_it_takes_one_with_matching_names() {
+    let dir = out_dir("blender-bone-heat");
+    let reference = atlas_skin_corpus::RIGGEDFIGURE.input_path();
+    let (renamed, plain) = (dir.join("blender_names.glb"), dir.join("plain_names.glb"));
+    run_blender("bone_heat.py", &[&reference, &renamed, &plain]);
+    let eval = |candidate: &Path| -> Value {
+        let args = [
+            Path::new("eval"),
+            &reference,
+            candidate,
+            Path::new("--json"),
+        ];
+        let output = atlas_skin_ok(&args.map(Path::as_os_str));
+        serde_json::from_slice(&output.stdout).unwrap()
+    };
+    let (with_blender_names, with_plain_names) = (eval(&renamed), eval(&plain));
+    let hows = |e: &Value| -> Vec<String> {
+        let matches = e["joint_matches"].as_array().unwrap();
+        matches
+            .iter()
+            .map(|m| m["how"].as_str().unwrap().to_string())
+            .collect()
+    };
+    assert!(hows(&with_blender_names)
+        .iter()
+        .all(|h| h == "name_ignoring_case"));
+    assert!(hows(&with_plain_names).iter().all(|h| h == "name"));
+    assert_eq!(
+        with_blender_names["matched"],
+        with_blender_names["vertices"]
+    );
+    for key in [
+        "weights_l1",
+        "deform_random",
+        "deform_random_dqs",
+        "deform_anim",
+        "bleeding",
+    ] {
+        assert_eq!(with_blender_names[key], with_plain_names[key], "{key}");
+    }
+    // Bone heat is not the artist's weighting: real, finite differences.
+    let max = with_blender_names["deform_random"]["max"].as_f64().unwrap();
+    assert!(max > 1e-3 && max < 0.5, "{max}");
 }
