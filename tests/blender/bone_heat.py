@@ -9,6 +9,7 @@ Usage: python bone_heat.py INPUT.glb BLENDER_NAMES.glb PLAIN_NAMES.glb
 import sys
 
 import bpy
+from scene import empty_scene, the_armature
 
 
 def export(path):
@@ -17,12 +18,9 @@ def export(path):
 
 def main():
     source, blender_names, plain_names = sys.argv[1:4]
-    bpy.ops.wm.read_factory_settings(use_empty=True)
+    empty_scene()
     bpy.ops.import_scene.gltf(filepath=source)
-    armatures = [o for o in bpy.data.objects if o.type == "ARMATURE"]
-    if len(armatures) != 1:
-        raise SystemExit(f"expected one armature, found {len(armatures)}")
-    armature = armatures[0]
+    armature = the_armature()
     meshes = [o for o in bpy.data.objects if o.type == "MESH" and o.parent == armature]
     if not meshes:
         raise SystemExit("no mesh is parented to the armature")

@@ -14,6 +14,7 @@ import json
 import sys
 
 import bpy
+from scene import empty_scene, the_armature
 from mathutils import Matrix, Quaternion
 
 # glTF (x, y, z) -> Blender (x, -z, y) and back.
@@ -24,12 +25,9 @@ def main():
     source, rotations_path, out = sys.argv[1:4]
     with open(rotations_path) as f:
         rotations = json.load(f)
-    bpy.ops.wm.read_factory_settings(use_empty=True)
+    empty_scene()
     bpy.ops.import_scene.fbx(filepath=source)
-    armatures = [o for o in bpy.data.objects if o.type == "ARMATURE"]
-    if len(armatures) != 1:
-        raise SystemExit(f"expected one armature, found {len(armatures)}")
-    armature = armatures[0]
+    armature = the_armature()
     # An imported animation would override the pose on every evaluation.
     for obj in bpy.data.objects:
         obj.animation_data_clear()
