@@ -5,9 +5,11 @@
 //! Everything that reads the corpus or runs node panics with a message naming what is
 //! missing and how to get it: tests never skip.
 
+mod damage;
 mod js;
 mod model;
 
+pub use damage::damaged_copies;
 pub use js::{node_check, node_json};
 pub use model::{
     find, Model, Reference, ARM, CESIUMMAN, ELEPHANT, HAND, MAKEHUMAN, MODELS, RIGGEDFIGURE,

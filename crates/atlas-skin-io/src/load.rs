@@ -148,8 +148,22 @@ fn attach_skeleton(
         "txt" => {
             let rig = rig_info::read(path, file_positions.len())?;
             if let Some(weights) = &rig.weights {
-                character.reference_weights =
-                    Some(kept_rows(character, weights, path, rig.skeleton.len())?);
+                let kept = kept_rows(character, weights, path, rig.skeleton.len())?;
+                let missing: Vec<usize> = (0..kept.vertex_count())
+                    .filter(|&v| kept.row(v).next().is_none())
+                    .collect();
+                if let Some(&first) = missing.first() {
+                    return Err(IoError::invalid(
+                        path,
+                        format!(
+                            "{} vertices of the mesh have no skin line (the first: vertex {}); \
+                             truncated file?",
+                            missing.len(),
+                            character.file_vertex[first]
+                        ),
+                    ));
+                }
+                character.reference_weights = Some(kept);
             }
             rig.skeleton
         }

@@ -39,7 +39,7 @@ type SkinLine = (usize, u32, Vec<(String, f32)>);
 /// [`IoError::Syntax`] with the line for: an unknown record, a missing or non-numeric
 /// field, a non-finite position or weight, a negative weight, a name that is no joint, a
 /// joint defined twice, a child with two parents, a vertex past the mesh's end or listed
-/// twice, a `skin` line with a name but no weight; [`IoError::Invalid`] for a file without
+/// twice, a `skin` line without a joint or with a name but no weight; [`IoError::Invalid`] for a file without
 /// joints, a `root` that has a parent, and a `hier` cycle.
 pub fn read(path: &Path, vertex_count: usize) -> Result<RigInfo, IoError> {
     let text = read_text(path)?;
@@ -95,6 +95,13 @@ pub fn read(path: &Path, vertex_count: usize) -> Result<RigInfo, IoError> {
                         ));
                     }
                     row.push((joint.to_string(), weight));
+                }
+                if row.is_empty() {
+                    return Err(IoError::syntax(
+                        path,
+                        line,
+                        format!("the skin line of vertex {vertex} names no joint"),
+                    ));
                 }
                 skins.push((line, vertex, row));
             }
@@ -273,6 +280,10 @@ mod tests {
                 ":2: vertex index 3 is out of range (3 defined)",
             ),
             ("joints a 0 0 0\nskin 0 a\n", ":2: missing weight"),
+            (
+                "joints a 0 0 0\nskin 0\n",
+                ":2: the skin line of vertex 0 names no joint",
+            ),
             ("joints a 0 0 0\nskin 0 a nan\n", ":2: weight is NaN"),
             (
                 "joints a 0 0 0\nskin 0 a -1\n",

@@ -15,6 +15,7 @@
 //!
 //! Animations, blend shapes and materials are not read.
 
+mod ascii_arrays;
 pub mod space;
 
 use crate::names::unique_names;
@@ -44,6 +45,9 @@ const SUM_TOLERANCE: f64 = 1e-2;
 pub fn read(path: &Path) -> Result<Character, IoError> {
     let bytes = crate::text::read_bytes(path)?;
     let scene = load_scene(path, &bytes)?;
+    if scene.metadata.ascii {
+        ascii_arrays::check(path, &String::from_utf8_lossy(&bytes))?;
+    }
     let mut warnings = Vec::new();
     let space = SpaceConversion::new(
         &scene.settings.axes,
