@@ -175,7 +175,8 @@ pub fn read(path: &Path, vertex_count: usize) -> Result<RigInfo, IoError> {
 
 /// The rig_info text of `skeleton` (bind positions) and `weights`, one `skin` line per
 /// row: `vertex_numbers[v]` is the number written for row v (the mesh file's vertex index).
-/// Weights of 0 are left out; numbers are written with the fewest digits that read back
+/// Weights of 0 are left out, and so are rows without any (the reader refuses a `skin`
+/// line without a joint); numbers are written with the fewest digits that read back
 /// to the same f32. Names are single tokens in the format: whitespace in a joint name
 /// becomes `_` (made unique again if that collides).
 pub fn to_text(skeleton: &Skeleton, weights: &VertexWeights, vertex_numbers: &[u32]) -> String {
@@ -201,8 +202,12 @@ pub fn to_text(skeleton: &Skeleton, weights: &VertexWeights, vertex_numbers: &[u
         }
     }
     for (v, &number) in vertex_numbers.iter().enumerate() {
+        let mut row = weights.row(v).filter(|&(_, w)| w > 0.0).peekable();
+        if row.peek().is_none() {
+            continue;
+        }
         let _ = write!(text, "skin {number}");
-        for (joint, weight) in weights.row(v).filter(|&(_, w)| w > 0.0) {
+        for (joint, weight) in row {
             let _ = write!(text, " {} {weight}", names[joint as usize]);
         }
         text.push('\n');
