@@ -311,12 +311,8 @@ fn hostile_fbx_and_rig_info() -> Vec<Case> {
         rig_case(
             "truncated rig_info",
             ("cut_rig.txt", "cut_rig.txt"),
-            rig[..rig.len() / 2]
-                .rsplit_once('\n')
-                .unwrap()
-                .0
-                .to_string(),
-            "have no skin line",
+            rig[..rig.find("skin 300 ").unwrap() + "skin 300 kubi".len()].to_string(),
+            "missing weight",
         ),
         rig_case(
             "rig_info with a cycle",

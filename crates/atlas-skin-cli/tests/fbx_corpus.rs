@@ -193,3 +193,17 @@ fn pose_and_report_take_fbx() {
         page.len()
     );
 }
+
+#[test]
+fn the_bind_pose_comes_from_the_clusters_not_the_current_nodes() {
+    // assimp's animation_with_skeleton was saved posed: node Bone.006 now sits at x = -8.29 m,
+    // its cluster's TransformLink (the bind pose) at x = -7.02 m.
+    let character = load_character(
+        fbx("assimp_animation_with_skeleton.fbx").as_ref(),
+        &LoadOptions::default(),
+    )
+    .unwrap();
+    let skeleton = character.skeleton.unwrap();
+    let at = skeleton.bind_positions()[skeleton.find("Bone.006").unwrap()];
+    assert!((at.x + 7.0216).abs() < 1e-3, "{at}");
+}

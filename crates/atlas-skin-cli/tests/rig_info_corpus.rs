@@ -123,3 +123,24 @@ fn skin_rig_info_round_trips_through_the_reader() {
     assert!(String::from_utf8_lossy(&output.stderr).contains("refusing to write over the input"));
     assert!(!dir.join("again.glb").exists(), "nothing is written");
 }
+
+#[test]
+fn a_rig_info_without_every_skin_line_gives_its_skeleton_and_no_weights() {
+    let dir = out_dir("rig-info-cut");
+    let (obj, rig) = obj_and_rig("498");
+    let text = std::fs::read_to_string(&rig).unwrap();
+    let cut = dir.join("cut_rig.txt");
+    std::fs::write(&cut, &text[..text.find("skin 300 ").unwrap()]).unwrap();
+    let options = LoadOptions {
+        skeleton: Some(cut),
+        ..LoadOptions::default()
+    };
+    let character = load_character(&obj, &options).unwrap();
+    assert_eq!(character.skeleton.unwrap().len(), 13);
+    assert!(character.reference_weights.is_none());
+    let warnings = character.warnings.join("\n");
+    assert!(
+        warnings.contains("116 vertices of the mesh have no skin line (the first: vertex 300)"),
+        "{warnings}"
+    );
+}

@@ -152,18 +152,16 @@ fn attach_skeleton(
                 let missing: Vec<usize> = (0..kept.vertex_count())
                     .filter(|&v| kept.row(v).next().is_none())
                     .collect();
-                if let Some(&first) = missing.first() {
-                    return Err(IoError::invalid(
-                        path,
-                        format!(
-                            "{} vertices of the mesh have no skin line (the first: vertex {}); \
-                             truncated file?",
-                            missing.len(),
-                            character.file_vertex[first]
-                        ),
-                    ));
+                match missing.first() {
+                    Some(&first) => character.warnings.push(format!(
+                        "{}: {} vertices of the mesh have no skin line (the first: vertex {}): \
+                         the file's weights are not used (truncated file, or another mesh?)",
+                        path.display(),
+                        missing.len(),
+                        character.file_vertex[first]
+                    )),
+                    None => character.reference_weights = Some(kept),
                 }
-                character.reference_weights = Some(kept);
             }
             rig.skeleton
         }

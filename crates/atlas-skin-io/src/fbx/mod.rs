@@ -295,11 +295,12 @@ fn finite_matrix(path: &Path, m: &ufbx::Matrix, what: &ufbx::String) -> Result<D
     }
 }
 
-/// How many stored skin rows summed to 1 (before normalising).
+/// How many stored skin rows summed to 1 (before normalising), and how many were empty.
 #[derive(Default)]
 struct SumCount {
     rows: usize,
     summing_to_one: usize,
+    unweighted: usize,
 }
 
 impl SumCount {
@@ -308,6 +309,12 @@ impl SumCount {
             warnings.push(format!(
                 "skin weights sum to 1 on {} of {} skinned vertices: rows normalised",
                 self.summing_to_one, self.rows
+            ));
+        }
+        if self.unweighted > 0 {
+            warnings.push(format!(
+                "{} vertices of skinned meshes have no skin weight (they cannot be posed)",
+                self.unweighted
             ));
         }
     }
@@ -326,8 +333,9 @@ struct PartsBuilder<'a> {
 
 impl PartsBuilder<'_> {
     /// Adds `mesh` if it belongs to the character: skinned (once, in bind space), or each
-    /// node instancing it that hangs under a joint (rigid) or under the skeleton's top node
-    /// (unbound); without a skeleton, every instance in its world placement.
+    /// node instancing it that hangs under a joint (rigid on it) or elsewhere under the
+    /// skeleton's top node (rigid on the root joint); without a skeleton, every instance in
+    /// its world placement.
     fn add_mesh(
         &mut self,
         scene: &ufbx::Scene,
@@ -447,16 +455,20 @@ impl PartsBuilder<'_> {
                         .get(weight.cluster_index as usize)
                         .copied()
                         .flatten();
-                    match (joint, row.iter_mut().find(|(j, _)| Some(*j) == joint)) {
-                        (_, _) if weight.weight == 0.0 => {}
-                        (Some(_), Some(entry)) => entry.1 += weight.weight,
-                        (Some(j), None) => row.push((j, weight.weight)),
-                        (None, _) => {}
+                    // Clusters of the same bone add up; zero weights are dropped.
+                    let Some(joint) = joint.filter(|_| weight.weight > 0.0) else {
+                        continue;
+                    };
+                    match row.iter_mut().find(|(j, _)| *j == joint) {
+                        Some(entry) => entry.1 += weight.weight,
+                        None => row.push((joint, weight.weight)),
                     }
                 }
             }
             let sum: f64 = row.iter().map(|(_, w)| w).sum();
-            if !row.is_empty() {
+            if row.is_empty() {
+                self.stored_sums.unweighted += 1;
+            } else {
                 self.stored_sums.rows += 1;
                 if (sum - 1.0).abs() <= SUM_TOLERANCE {
                     self.stored_sums.summing_to_one += 1;
