@@ -114,6 +114,24 @@ fn inspect_agrees_with_the_readme_and_skin_writes_valid_glbs() {
     for result in node_check("validate.mjs", &outputs) {
         assert_eq!(result["errors"], 0, "{result}");
     }
+    // Base colours reach the glb: one primitive per material.
+    let heaps = load_character(&outputs[1], &LoadOptions::default()).unwrap();
+    let document = heaps.gltf.unwrap().document;
+    assert_eq!(
+        document["meshes"][0]["primitives"]
+            .as_array()
+            .unwrap()
+            .len(),
+        2
+    );
+    let huesitos = load_character(&outputs[3], &LoadOptions::default()).unwrap();
+    let document = huesitos.gltf.unwrap().document;
+    let color = &document["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"];
+    // Diffuse colour (0.514, 0.606, 0.891) × diffuse factor 0.8.
+    let expected = [0.4112, 0.4849, 0.7130, 1.0];
+    for (c, e) in color.as_array().unwrap().iter().zip(expected) {
+        assert!((c.as_f64().unwrap() - e).abs() < 1e-3, "{color}");
+    }
 }
 
 #[test]

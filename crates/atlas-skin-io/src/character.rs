@@ -77,6 +77,11 @@ pub struct Character {
     /// The meshes of an input that holds several (FBX), in `mesh` order; empty for the
     /// other formats.
     pub parts: Vec<MeshPart>,
+    /// Surface colours of an input that has materials (FBX), and the material of every
+    /// triangle (`None`: no material); both empty when the input has none. The glTF writer
+    /// makes one primitive per material.
+    pub materials: Vec<Material>,
+    pub triangle_materials: Vec<Option<u32>>,
     /// How the reader converted units and axes (FBX: to glTF's metres, +Y up); `None` when
     /// they stay as in the file.
     pub space: Option<String>,
@@ -92,6 +97,13 @@ pub struct MeshPart {
     pub vertices: Range<usize>,
     pub triangles: Range<usize>,
     pub binding: PartBinding,
+}
+
+/// A material's base colour, linear RGBA in [0, 1] (glTF's `baseColorFactor`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Material {
+    pub name: String,
+    pub base_color: [f32; 4],
 }
 
 /// How a part moves with the skeleton in the file.
@@ -132,6 +144,8 @@ impl Character {
             file_vertex,
             end_joints: Vec::new(),
             parts: Vec::new(),
+            materials: Vec::new(),
+            triangle_materials: Vec::new(),
             space: None,
             gltf: None,
         }

@@ -28,7 +28,7 @@ pub mod stl;
 mod text;
 pub mod tgf;
 
-pub use character::{Character, LoadOptions, MeshPart, PartBinding, TriangleMesh};
+pub use character::{Character, LoadOptions, Material, MeshPart, PartBinding, TriangleMesh};
 pub use error::IoError;
 pub use load::load_character;
 pub use output::{check_not_input, write_atomically};

@@ -13,13 +13,15 @@
 //!   to 1); weight 1 on the joint above a rigid part.
 //! - Units and axes converted to glTF's ([`space::SpaceConversion`]).
 //!
-//! Animations, blend shapes and materials are not read.
+//! - Materials: each face's base colour (the written glb gets one primitive per material).
+//!
+//! Animations, blend shapes, textures and UVs are not read.
 
 mod ascii_arrays;
 pub mod space;
 
 use crate::names::unique_names;
-use crate::{Character, IoError, MeshPart, PartBinding, TriangleMesh};
+use crate::{Character, IoError, Material, MeshPart, PartBinding, TriangleMesh};
 use atlas_skin_runtime::{Rig, Skeleton, VertexWeights, NO_PARENT};
 use glam::{DMat4, DVec3};
 use space::SpaceConversion;
@@ -69,6 +71,9 @@ pub fn read(path: &Path) -> Result<Character, IoError> {
         rows: Vec::new(),
         parts: Vec::new(),
         stored_sums: SumCount::default(),
+        materials: Vec::new(),
+        material_of: HashMap::new(),
+        triangle_materials: Vec::new(),
     };
     for mesh in scene.meshes.iter() {
         builder.add_mesh(&scene, mesh, &mut warnings)?;
@@ -84,6 +89,8 @@ pub fn read(path: &Path) -> Result<Character, IoError> {
         rows,
         parts,
         stored_sums,
+        materials,
+        triangle_materials,
         ..
     } = builder;
     let mut character = Character::new(path, mesh);
@@ -95,6 +102,10 @@ pub fn read(path: &Path) -> Result<Character, IoError> {
         character.reference_weights = Some(VertexWeights::from_rows(rows));
     }
     character.parts = parts;
+    if !materials.is_empty() {
+        character.materials = materials;
+        character.triangle_materials = triangle_materials;
+    }
     character.space = Some(space.description.clone());
     character.warnings = warnings;
     Ok(character)
@@ -329,6 +340,10 @@ struct PartsBuilder<'a> {
     rows: Vec<Vec<(u32, f32)>>,
     parts: Vec<MeshPart>,
     stored_sums: SumCount,
+    materials: Vec<Material>,
+    /// Index in `materials` of a ufbx material (by element id).
+    material_of: HashMap<u32, u32>,
+    triangle_materials: Vec<Option<u32>>,
 }
 
 impl PartsBuilder<'_> {
@@ -483,6 +498,36 @@ impl PartsBuilder<'_> {
         Ok(rows)
     }
 
+    /// The index of `material` in the character's materials, added on first use: its base
+    /// colour (ufbx's PBR reading of the FBX material: diffuse colour × factor) clamped to
+    /// [0, 1], white where not finite.
+    fn material_index(&mut self, material: &ufbx::Material) -> u32 {
+        let id = material.element.element_id;
+        if let Some(&index) = self.material_of.get(&id) {
+            return index;
+        }
+        let color = material.pbr.base_color.value_vec4;
+        let factor = match &material.pbr.base_factor {
+            f if f.has_value => f.value_vec4.x,
+            _ => 1.0,
+        };
+        let rgb = [color.x, color.y, color.z].map(|c| c * factor);
+        let base_color = [rgb[0], rgb[1], rgb[2], color.w].map(|c| {
+            if c.is_finite() {
+                c.clamp(0.0, 1.0) as f32
+            } else {
+                1.0
+            }
+        });
+        let index = self.materials.len() as u32;
+        self.materials.push(Material {
+            name: material.element.name.to_string(),
+            base_color,
+        });
+        self.material_of.insert(id, index);
+        index
+    }
+
     /// Whether `node` hangs under the same top node (child of the root) as the skeleton.
     fn shares_top_node(&self, scene: &ufbx::Scene, node: &ufbx::Node) -> bool {
         let top = |node: &ufbx::Node| {
@@ -523,8 +568,13 @@ impl PartsBuilder<'_> {
         }
         let first_triangle = self.mesh.triangles.len();
         let mut corners = Vec::new();
-        for &face in mesh.faces.iter() {
+        for (f, &face) in mesh.faces.iter().enumerate() {
             ufbx::triangulate_face_vec(&mut corners, mesh, face);
+            let material = mesh
+                .face_material
+                .get(f)
+                .and_then(|&m| mesh.materials.get(m as usize))
+                .map(|m| self.material_index(m));
             for t in corners.chunks_exact(3) {
                 let vertex = |k: usize| -> Result<u32, IoError> {
                     let v = mesh.vertex_indices.get(t[k] as usize).copied();
@@ -543,6 +593,7 @@ impl PartsBuilder<'_> {
                 } else {
                     [a, b, c]
                 });
+                self.triangle_materials.push(material);
             }
         }
         self.rows.extend(rows);
