@@ -12,8 +12,8 @@ use std::path::PathBuf;
 /// Arguments.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// The reference character with its weights: .glb/.gltf/.vrm, or a mesh with
-    /// --skeleton and --weights.
+    /// The reference character with its weights: .glb/.gltf/.vrm, .fbx, or a mesh with
+    /// --skeleton and --weights (or an OBJ with RigNet's --skeleton X_rig.txt).
     pub reference: PathBuf,
     /// The candidate: a skinned file (.glb/.gltf/.vrm, .fbx) of the same character, e.g.
     /// another tool's export. Joints are matched by name, then by name ignoring case and
