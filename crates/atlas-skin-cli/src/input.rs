@@ -9,7 +9,8 @@ use std::path::PathBuf;
 /// How to read a character's files, besides its main file.
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct ReadArgs {
-    /// Skeleton file for a mesh without one: .tgf, .bvh, .mhskel or .json.
+    /// Skeleton file for a mesh without one: .tgf, .bvh, .mhskel, .json, or RigNet's
+    /// rig_info X_rig.txt (whose skin lines also give reference weights).
     #[arg(long)]
     pub skeleton: Option<PathBuf>,
     /// Use only the faces of this OBJ group (e.g. MakeHuman's `body`).
@@ -33,8 +34,8 @@ impl ReadArgs {
 /// Where the character comes from.
 #[derive(clap::Args, Debug, Clone)]
 pub struct InputArgs {
-    /// The character: .glb/.gltf/.vrm (mesh and skeleton), or a mesh (.obj, .mesh, .off,
-    /// .ply, .stl) with --skeleton. Without it: the built-in demo character.
+    /// The character: .glb/.gltf/.vrm or .fbx (mesh and skeleton), or a mesh (.obj, .mesh,
+    /// .off, .ply, .stl) with --skeleton. Without it: the built-in demo character.
     pub input: Option<PathBuf>,
     #[command(flatten)]
     pub read: ReadArgs,

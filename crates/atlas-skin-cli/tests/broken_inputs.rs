@@ -1,9 +1,10 @@
 //! Broken inputs give a clear error: `atlas-skin inspect` and `atlas-skin skin` exit
 //! non-zero, stderr names the file and the problem, nothing panics and `skin` writes no file.
+//! Hostile FBX and rig_info files are made from the corpus's (../shared/data).
 
 mod support;
 
-use atlas_skin_corpus::RIGGEDSIMPLE;
+use atlas_skin_corpus::{data_file, RIGGEDSIMPLE};
 use std::path::{Path, PathBuf};
 use std::process::Output;
 use support::{atlas_skin, out_dir};
@@ -71,7 +72,7 @@ fn cases() -> Vec<Case> {
     wrong_magic[..4].copy_from_slice(b"glTX");
     let mut nan = TRIANGLE;
     nan[4] = f32::NAN;
-    vec![
+    let mut cases = vec![
         Case {
             name: "truncated glb",
             files: vec![("truncated.glb", glb[..glb.len() / 2].to_vec())],
@@ -183,6 +184,160 @@ fn cases() -> Vec<Case> {
             names: "absent.glb",
             problem: "cannot read",
         },
+    ];
+    cases.extend(hostile_fbx_and_rig_info());
+    cases
+}
+
+/// A case reading the one file `file` (with `before` arguments ahead of it).
+fn file_case(
+    name: &'static str,
+    files: Vec<(&'static str, Vec<u8>)>,
+    before: &[&'static str],
+    (file, names): (&'static str, &'static str),
+    problem: &'static str,
+) -> Case {
+    let arg: &'static str = Box::leak(format!("{{dir}}/{file}").into_boxed_str());
+    let args: Vec<&'static str> = before.iter().copied().chain([arg]).collect();
+    Case {
+        name,
+        files,
+        args: Box::leak(args.into_boxed_slice()),
+        names,
+        problem,
+    }
+}
+
+/// The hostile files of the FBX and rig_info readers: truncated, wrong header, huge
+/// declared counts, a node cycle, weights on vertices past the end, non-numbers.
+fn hostile_fbx_and_rig_info() -> Vec<Case> {
+    let knight = std::fs::read(data_file("fbx/KayKit_Knight.fbx")).unwrap();
+    let heaps = std::fs::read_to_string(data_file("fbx/Skeleton_heaps_ascii.fbx")).unwrap();
+    let line_of = |needle: &str| heaps.lines().position(|l| l.contains(needle)).unwrap() + 1;
+    // Heaps's ASCII FBX with `from` replaced by `to` on line `line`, read as `file`.
+    let heaps_edit = |name,
+                      (file, line): (&'static str, usize),
+                      (from, to): (&str, &str),
+                      problem| {
+        let text: String = heaps
+            .lines()
+            .enumerate()
+            .map(|(i, l)| if i + 1 == line { l.replacen(from, to, 1) } else { l.to_string() } + "\n")
+            .collect();
+        file_case(
+            name,
+            vec![(file, text.into_bytes())],
+            &[],
+            (file, file),
+            problem,
+        )
+    };
+    let rig = std::fs::read_to_string(data_file("rignet-format/498_rig.txt")).unwrap();
+    let obj = std::fs::read(data_file("rignet-format/498.obj")).unwrap();
+    // 498.obj with the rig_info `text` as its --skeleton `file`.
+    let rig_case = |name, (file, names): (&'static str, &'static str), text: String, problem| {
+        let files = vec![("498.obj", obj.clone()), (file, text.into_bytes())];
+        file_case(
+            name,
+            files,
+            &["{dir}/498.obj", "--skeleton"],
+            (file, names),
+            problem,
+        )
+    };
+    // Binary FBX: the array header after the first "Vertices" name is (type 'd', length,
+    // encoding, compressed length); a length of 2^31 - 1 doubles is 16 GiB.
+    let mut huge = knight.clone();
+    let at = knight.windows(8).position(|w| w == b"Vertices").unwrap() + 9;
+    huge[at..at + 4].copy_from_slice(&0x7fff_ffffu32.to_le_bytes());
+    let mut header = knight.clone();
+    header[..7].copy_from_slice(b"Kaydarb");
+    let vertices = line_of("Vertices: *1335 {");
+    let indexes = line_of("Indexes: *50 {");
+    let root_connection = line_of("C: \"OO\",551080896,0");
+    let half = knight[..knight.len() / 2].to_vec();
+    vec![
+        file_case(
+            "truncated FBX",
+            vec![("half.fbx", half)],
+            &[],
+            ("half.fbx", "half.fbx"),
+            "not a readable FBX file",
+        ),
+        file_case(
+            "FBX with a wrong header",
+            vec![("header.fbx", header)],
+            &[],
+            ("header.fbx", "header.fbx"),
+            "not a readable FBX file: Not an FBX file",
+        ),
+        file_case(
+            "binary FBX declaring a huge array",
+            vec![("huge.fbx", huge)],
+            &[],
+            ("huge.fbx", "huge.fbx"),
+            "Memory limit exceeded",
+        ),
+        heaps_edit(
+            "ASCII FBX declaring a huge array",
+            ("count.fbx", vertices),
+            ("*1335", "*999999999999"),
+            "declares 999999999999 values but holds 1335",
+        ),
+        heaps_edit(
+            "FBX node cycle",
+            ("cycle.fbx", root_connection),
+            ("C: \"OO\",551080896,0", "C: \"OO\",551080896,551069616"),
+            "Cyclic node hierarchy",
+        ),
+        heaps_edit(
+            "FBX weights on a vertex past the end",
+            ("past.fbx", indexes + 1),
+            ("a: 0,", "a: 100000,"),
+            "weights vertex 100000, but the mesh has 445 vertices",
+        ),
+        heaps_edit(
+            "FBX array with a word",
+            ("word.fbx", vertices + 1),
+            ("a: -0.559155941009521", "a: abc"),
+            "array value \"abc\" is not a number",
+        ),
+        heaps_edit(
+            "FBX with a NaN position",
+            ("nan.fbx", vertices + 1),
+            ("a: -0.559155941009521", "a: nan"),
+            "is not finite",
+        ),
+        rig_case(
+            "truncated rig_info",
+            ("cut_rig.txt", "cut_rig.txt"),
+            rig[..rig.find("skin 300 ").unwrap() + "skin 300 kubi".len()].to_string(),
+            "missing weight",
+        ),
+        rig_case(
+            "rig_info with a cycle",
+            ("cycle_rig.txt", "cycle_rig.txt"),
+            rig.replace("root kosi\n", "hier kubi kosi\n"),
+            "cycle",
+        ),
+        rig_case(
+            "rig_info weight on a vertex past the end",
+            ("past_rig.txt", "past_rig.txt"),
+            rig.replace("skin 0 ", "skin 416 "),
+            "vertex index 416 is out of range (416 defined)",
+        ),
+        rig_case(
+            "rig_info with a word for a number",
+            ("word_rig.txt", "word_rig.txt:1"),
+            rig.replacen("joints jyowanL 0.06800120", "joints jyowanL x", 1),
+            "x coordinate \"x\" is not a valid number",
+        ),
+        rig_case(
+            "rig_info declaring a huge vertex",
+            ("huge_rig.txt", "huge_rig.txt"),
+            rig.replace("skin 0 ", "skin 99999999999999999999 "),
+            "vertex index \"99999999999999999999\"",
+        ),
     ]
 }
 

@@ -97,6 +97,7 @@ fn reference_weights_as_candidate_give_zeros_and_the_json_contract_holds() {
                 "deform_anim",
                 "deform_random",
                 "deform_random_dqs",
+                "joint_matches",
                 "joints",
                 "matched",
                 "validity",

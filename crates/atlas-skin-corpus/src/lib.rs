@@ -5,9 +5,11 @@
 //! Everything that reads the corpus or runs node panics with a message naming what is
 //! missing and how to get it: tests never skip.
 
+mod damage;
 mod js;
 mod model;
 
+pub use damage::damaged_copies;
 pub use js::{node_check, node_json};
 pub use model::{
     find, Model, Reference, ARM, CESIUMMAN, ELEPHANT, HAND, MAKEHUMAN, MODELS, RIGGEDFIGURE,
@@ -34,6 +36,18 @@ pub fn data_dir() -> PathBuf {
 /// `../shared/data/models`, one folder per model; panics when it is missing.
 pub fn models_dir() -> PathBuf {
     data_dir().join("models")
+}
+
+/// The file `relative` of `../shared/data` (e.g. `fbx/KayKit_Knight.fbx`); panics when it
+/// is missing.
+pub fn data_file(relative: &str) -> PathBuf {
+    let path = data_dir().join(relative);
+    assert!(
+        path.is_file(),
+        "corpus file {} is missing (tests never skip)",
+        path.display()
+    );
+    path
 }
 
 /// The motion clip `file` of `../shared/data/motion` (e.g. `walk.bvh`); panics when it is

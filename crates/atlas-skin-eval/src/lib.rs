@@ -47,8 +47,12 @@ pub enum EvalError {
     },
     #[error("candidate vertex {vertex} has a non-finite weight {weight}")]
     CandidateWeightNotFinite { vertex: usize, weight: f32 },
-    #[error("candidate joint {joint} ({name:?}) is not in the reference skeleton")]
-    UnknownJoint { joint: usize, name: String },
+    #[error("candidate joint {joint} ({name:?}) matches no reference joint by name nor by bind position (within {tolerance:.3e}): not the same skeleton?")]
+    UnknownJoint {
+        joint: usize,
+        name: String,
+        tolerance: f64,
+    },
     #[error("invalid reference animation: {0}")]
     Animation(RuntimeError),
     #[error("the reference rig drives {rig} joints but the skeleton has {skeleton}")]
@@ -109,6 +113,9 @@ pub struct EvalOptions {
     pub bleeding_radius: f64,
     /// Vertex matching tolerance as a fraction of the diagonal (1e-5).
     pub match_tolerance: f64,
+    /// Joint matching tolerance by bind position, as a fraction of the diagonal (1e-3),
+    /// for joints whose names match none of the reference's.
+    pub joint_tolerance: f64,
     /// Keep only this many largest reference weights per vertex before renormalising
     /// (BASELINES.md prunes MakeHuman's to 4); `None` keeps them all.
     pub reference_max_influences: Option<usize>,
@@ -126,6 +133,7 @@ impl Default for EvalOptions {
             anim_frames: 8,
             bleeding_radius: 0.05,
             match_tolerance: 1e-5,
+            joint_tolerance: 1e-3,
             reference_max_influences: None,
             worst: 0,
         }
@@ -144,6 +152,10 @@ pub struct Evaluation {
     pub matched: usize,
     pub candidate_vertices: usize,
     pub candidate_joints: usize,
+    /// How each candidate joint was matched to a reference joint, in candidate order
+    /// (empty in JSON written before this field existed).
+    #[serde(default)]
+    pub joint_matches: Vec<matching::JointPair>,
     pub weights_l1: WeightsL1,
     /// LBS in random poses.
     pub deform_random: DeformError,
@@ -223,6 +235,7 @@ pub fn evaluate(input: &EvalInput, options: &EvalOptions) -> Result<Evaluation, 
         matched: aligned.rest_positions.len(),
         candidate_vertices: candidate.positions.len(),
         candidate_joints: candidate.skeleton.len(),
+        joint_matches: aligned.joint_matches,
         weights_l1: weights_l1::weights_l1(&aligned.reference, &aligned.candidate, joints),
         deform_random: random_lbs.total,
         deform_random_dqs: deform_with(&random_palettes, Skinning::DualQuaternion).total,
@@ -277,13 +290,29 @@ struct Aligned {
     surface_of_row: Vec<u32>,
     /// The pruned, renormalised reference rows of every stored vertex.
     reference_stored: VertexWeights,
+    /// The reference joint of every candidate joint and how it was found.
+    joint_matches: Vec<matching::JointPair>,
 }
 
 /// Matches the candidate's vertices and joints to the reference's and lines up their rows.
 fn align(input: &EvalInput, options: &EvalOptions, diagonal: f64) -> Result<Aligned, EvalError> {
     let (reference, candidate) = (input.reference, input.candidate);
-    let joint_of_candidate =
-        matching::match_joints(&reference.skeleton.names, &candidate.skeleton.names)?;
+    let (reference_at, candidate_at) = (
+        reference.skeleton.bind_positions(),
+        candidate.skeleton.bind_positions(),
+    );
+    let joint_matches = matching::match_joints(
+        matching::JointSet {
+            names: &reference.skeleton.names,
+            positions: &reference_at,
+        },
+        matching::JointSet {
+            names: &candidate.skeleton.names,
+            positions: &candidate_at,
+        },
+        options.joint_tolerance * diagonal,
+    )?;
+    let joint_of_candidate = matching::reference_indices(&reference.skeleton.names, &joint_matches);
     let surface_of_stored = &input.surface.welded_of_stored;
     let compared: Vec<usize> = (0..reference.positions.len())
         .filter(|&v| surface_of_stored[v] != UNREFERENCED)
@@ -318,6 +347,7 @@ fn align(input: &EvalInput, options: &EvalOptions, diagonal: f64) -> Result<Alig
         })),
         surface_of_row: pairs.iter().map(|&(r, _)| surface_of_stored[r]).collect(),
         reference_stored,
+        joint_matches,
     })
 }
 

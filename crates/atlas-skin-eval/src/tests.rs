@@ -213,7 +213,13 @@ fn weight_moved_to_the_far_end_bleeds() {
 #[test]
 fn inputs_that_cannot_be_compared_are_errors() {
     let f = fixture(1.0);
-    let other = skeleton(["shoulder", "tail"]);
+    // "tail" matches no name, and lies far from the free "elbow".
+    let other = Skeleton::from_positions(
+        vec!["shoulder".into(), "tail".into()],
+        vec![NO_PARENT, 0],
+        &[Vec3::ZERO, Vec3::new(2.0, 5.0, 0.0)],
+    )
+    .unwrap();
     let far: Vec<Vec3> = f.positions.iter().map(|p| *p + Vec3::splat(10.0)).collect();
     let short = VertexWeights::from_rows([[(0u32, 1.0f32)]]);
     let out_of_range = VertexWeights::from_rows(f.positions.iter().map(|_| [(2u32, 1.0f32)]));

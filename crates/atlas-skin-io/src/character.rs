@@ -2,6 +2,7 @@
 
 use atlas_skin_runtime::{Clip, Rig, Skeleton, VertexWeights};
 use glam::Vec3;
+use std::ops::Range;
 use std::path::PathBuf;
 
 /// A triangle mesh exactly as stored in the file (after polygon triangulation).
@@ -73,9 +74,48 @@ pub struct Character {
     /// skeleton (libigl's skinning handles are the bone edges, so a leaf point is never
     /// one). The skin command gives them no boundary.
     pub end_joints: Vec<u32>,
+    /// The meshes of an input that holds several (FBX), in `mesh` order; empty for the
+    /// other formats.
+    pub parts: Vec<MeshPart>,
+    /// Surface colours of an input that has materials (FBX), and the material of every
+    /// triangle (`None`: no material); both empty when the input has none. The glTF writer
+    /// makes one primitive per material.
+    pub materials: Vec<Material>,
+    pub triangle_materials: Vec<Option<u32>>,
+    /// How the reader converted units and axes (FBX: to glTF's metres, +Y up); `None` when
+    /// they stay as in the file.
+    pub space: Option<String>,
     /// For glTF input: the source document, its buffers and where each primitive went in
     /// `mesh` (what the glTF writer needs to preserve the document).
     pub gltf: Option<crate::gltf::GltfSource>,
+}
+
+/// One mesh of a multi-mesh input and where it went in [`Character::mesh`].
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct MeshPart {
+    pub name: String,
+    pub vertices: Range<usize>,
+    pub triangles: Range<usize>,
+    pub binding: PartBinding,
+}
+
+/// A material's base colour, linear RGBA in [0, 1] (glTF's `baseColorFactor`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Material {
+    pub name: String,
+    pub base_color: [f32; 4],
+}
+
+/// How a part moves with the skeleton in the file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PartBinding {
+    /// Deformed by the skin: its reference weights are the file's.
+    Skinned,
+    /// A rigid mesh under joint `joint` in the node tree (or in the skeleton's tree but
+    /// under no joint: on the root joint, with a warning): weight 1 on that joint.
+    Rigid { joint: u32 },
+    /// A mesh of an input without a skeleton, placed as in the file.
+    Unbound,
 }
 
 /// How to read an input.
@@ -103,6 +143,10 @@ impl Character {
             warnings: Vec::new(),
             file_vertex,
             end_joints: Vec::new(),
+            parts: Vec::new(),
+            materials: Vec::new(),
+            triangle_materials: Vec::new(),
+            space: None,
             gltf: None,
         }
     }

@@ -5,27 +5,30 @@
 //! artist weights when the file has them. The glTF writer puts new weights into a copy of
 //! the input document, or builds a new document for other inputs.
 //!
-//! Units and axes stay as in the file.
+//! Units and axes stay as in the file, except FBX's, which are converted to glTF's.
 
 pub mod bvh;
 pub mod character;
 pub mod dmat;
 pub mod error;
+pub mod fbx;
 pub mod gltf;
 pub mod load;
 pub mod medit;
 pub mod mhskel;
 pub mod mhw;
+mod names;
 pub mod obj;
 pub mod off;
 pub mod output;
 pub mod ply;
+pub mod rig_info;
 pub mod skeleton_json;
 pub mod stl;
 mod text;
 pub mod tgf;
 
-pub use character::{Character, LoadOptions, TriangleMesh};
+pub use character::{Character, LoadOptions, Material, MeshPart, PartBinding, TriangleMesh};
 pub use error::IoError;
 pub use load::load_character;
-pub use output::write_atomically;
+pub use output::{check_not_input, write_atomically};

@@ -3,24 +3,27 @@
 
 use crate::text::check_file;
 use crate::{
-    bvh, dmat, gltf, medit, mhskel, mhw, obj, off, ply, skeleton_json, stl, tgf, Character,
-    IoError, LoadOptions, TriangleMesh,
+    bvh, dmat, fbx, gltf, medit, mhskel, mhw, obj, off, ply, rig_info, skeleton_json, stl, tgf,
+    Character, IoError, LoadOptions, TriangleMesh,
 };
 use atlas_skin_runtime::{Rig, VertexWeights};
 use glam::Vec3;
 use std::path::Path;
 
-const MESH_EXTENSIONS: &str = ".glb, .gltf, .vrm, .obj, .mesh, .off, .ply or .stl";
-const SKELETON_EXTENSIONS: &str = ".tgf, .bvh, .mhskel or .json";
+const MESH_EXTENSIONS: &str = ".glb, .gltf, .vrm, .fbx, .obj, .mesh, .off, .ply or .stl";
+const SKELETON_EXTENSIONS: &str = ".tgf, .bvh, .mhskel, .json or RigNet's _rig.txt";
 const WEIGHTS_EXTENSIONS: &str = ".dmat or .mhw";
 
 /// Reads the character at `path` with `options`.
 ///
 /// - `.glb`, `.gltf`, `.vrm`: mesh, skeleton, weights and animations from the document.
+/// - `.fbx`: skinned and rigid meshes, skeleton and weights, converted to glTF's units
+///   and axes ([`fbx::read`]).
 /// - `.obj`, `.mesh`, `.off`, `.ply`, `.stl`: a mesh; vertices no (kept) triangle uses are
 ///   dropped and [`Character::file_vertex`] maps the rest back to the file's numbering.
-/// - `options.skeleton` (`.tgf`, `.bvh`, `.mhskel`, `.json`) gives a mesh its skeleton;
-///   without one the character has none and a warning says so.
+/// - `options.skeleton` (`.tgf`, `.bvh`, `.mhskel`, `.json`, RigNet's `_rig.txt`) gives a
+///   mesh its skeleton; without one the character has none and a warning says so. A
+///   rig_info file's `skin` lines also give the reference weights.
 /// - `options.weights` (`.dmat`, `.mhw`) gives reference weights, one row per vertex of
 ///   the mesh file.
 ///
@@ -34,7 +37,7 @@ pub fn load_character(path: &Path, options: &LoadOptions) -> Result<Character, I
         return Err(IoError::invalid(path, "--group applies to OBJ files only"));
     }
     let file_mesh = match extension.as_str() {
-        "glb" | "gltf" | "vrm" => None,
+        "glb" | "gltf" | "vrm" | "fbx" => None,
         "obj" => Some(obj::read(path, options.group.as_deref())?),
         "mesh" => Some(medit::read(path)?),
         "off" => Some(off::read(path)?),
@@ -45,7 +48,11 @@ pub fn load_character(path: &Path, options: &LoadOptions) -> Result<Character, I
     let (mut character, file_positions) = match file_mesh {
         Some(file_mesh) => (compacted_character(path, &file_mesh), file_mesh.positions),
         None => {
-            let character = gltf::read(path)?;
+            let character = if extension == "fbx" {
+                fbx::read(path)?
+            } else {
+                gltf::read(path)?
+            };
             let positions = character.mesh.positions.clone();
             (character, positions)
         }
@@ -138,6 +145,26 @@ fn attach_skeleton(
         }
         "mhskel" => mhskel::read(path, file_positions)?,
         "json" => skeleton_json::read(path)?,
+        "txt" => {
+            let rig = rig_info::read(path, file_positions.len())?;
+            if let Some(weights) = &rig.weights {
+                let kept = kept_rows(character, weights, path, rig.skeleton.len())?;
+                let missing: Vec<usize> = (0..kept.vertex_count())
+                    .filter(|&v| kept.row(v).next().is_none())
+                    .collect();
+                match missing.first() {
+                    Some(&first) => character.warnings.push(format!(
+                        "{}: {} vertices of the mesh have no skin line (the first: vertex {}): \
+                         the file's weights are not used (truncated file, or another mesh?)",
+                        path.display(),
+                        missing.len(),
+                        character.file_vertex[first]
+                    )),
+                    None => character.reference_weights = Some(kept),
+                }
+            }
+            rig.skeleton
+        }
         other => return Err(unsupported(path, other.to_string(), SKELETON_EXTENSIONS)),
     };
     if skeleton.is_empty() {
@@ -148,6 +175,26 @@ fn attach_skeleton(
     }
     character.skeleton = Some(skeleton);
     Ok(bone_joints)
+}
+
+/// The rows of `file_weights` (one per vertex of the mesh file) of the character's kept
+/// vertices, checked against `joint_count` joints.
+fn kept_rows(
+    character: &Character,
+    file_weights: &VertexWeights,
+    path: &Path,
+    joint_count: usize,
+) -> Result<VertexWeights, IoError> {
+    let weights = VertexWeights::from_rows(
+        character
+            .file_vertex
+            .iter()
+            .map(|&v| file_weights.row(v as usize).collect::<Vec<_>>()),
+    );
+    weights
+        .validate(joint_count)
+        .map_err(|error| IoError::invalid(path, error.to_string()))?;
+    Ok(weights)
 }
 
 /// Reads the weights file into `character.reference_weights`: one row per vertex of the
@@ -200,15 +247,7 @@ fn attach_weights(
         "mhw" => mhw::read(path, skeleton, file_vertex_count)?,
         other => return Err(unsupported(path, other.to_string(), WEIGHTS_EXTENSIONS)),
     };
-    let weights = VertexWeights::from_rows(
-        character
-            .file_vertex
-            .iter()
-            .map(|&v| file_weights.row(v as usize).collect::<Vec<_>>()),
-    );
-    weights
-        .validate(skeleton.len())
-        .map_err(|error| IoError::invalid(path, error.to_string()))?;
+    let weights = kept_rows(character, &file_weights, path, skeleton.len())?;
     if character.reference_weights.is_some() {
         character.warnings.push(format!(
             "the input's own weights were replaced by {}",

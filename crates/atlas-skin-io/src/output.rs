@@ -8,15 +8,15 @@ use std::path::Path;
 /// error. A missing output folder is created.
 ///
 /// # Errors
-/// [`IoError::WouldOverwriteInput`] when `out` is the file `input` (same path after
+/// [`IoError::WouldOverwriteInput`] when `out` is one of the files `inputs` (same path after
 /// resolving links), [`IoError::IsDirectory`] when `out` is a folder, [`IoError::Write`]
 /// when the file cannot be written.
-pub fn write_atomically(out: &Path, input: Option<&Path>, bytes: &[u8]) -> Result<(), IoError> {
-    if input.is_some_and(|input| is_same_file(out, input)) {
-        return Err(IoError::WouldOverwriteInput {
-            path: out.to_path_buf(),
-        });
-    }
+pub fn write_atomically<'a>(
+    out: &Path,
+    inputs: impl IntoIterator<Item = &'a Path>,
+    bytes: &[u8],
+) -> Result<(), IoError> {
+    check_not_input(out, inputs)?;
     if out.is_dir() {
         return Err(IoError::IsDirectory {
             path: out.to_path_buf(),
@@ -42,6 +42,20 @@ pub fn write_atomically(out: &Path, input: Option<&Path>, bytes: &[u8]) -> Resul
         // Best effort: the temporary file may not exist if its creation failed.
         let _ = std::fs::remove_file(&temporary);
         return Err(write_error(source));
+    }
+    Ok(())
+}
+
+/// [`IoError::WouldOverwriteInput`] when `out` is one of the files `inputs`: lets a
+/// command refuse an output before it writes any other.
+pub fn check_not_input<'a>(
+    out: &Path,
+    inputs: impl IntoIterator<Item = &'a Path>,
+) -> Result<(), IoError> {
+    if inputs.into_iter().any(|input| is_same_file(out, input)) {
+        return Err(IoError::WouldOverwriteInput {
+            path: out.to_path_buf(),
+        });
     }
     Ok(())
 }

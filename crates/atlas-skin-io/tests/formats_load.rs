@@ -92,6 +92,7 @@ fn load_errors_name_the_file_and_problem() {
             ),
             ("joints.dmat", b"3 5\n0 0 0 0 0\n0 0 0 0 0\n1 1 1 1 1\n"),
             ("s.txt", b"x"),
+            ("s.xyz", b"x"),
             ("empty.json", br#"{"joints": []}"#),
         ],
     );
@@ -131,8 +132,12 @@ fn load_errors_name_the_file_and_problem() {
             "no group named \"body\" (groups in the file: left, right)",
         ),
         (
+            load("m.obj", options(&dir, Some("s.xyz"), None)),
+            "s.xyz: unsupported file type \"xyz\"",
+        ),
+        (
             load("m.obj", options(&dir, Some("s.txt"), None)),
-            "s.txt: unsupported file type \"txt\"",
+            "s.txt:1: unknown record \"x\" (expected joints, root, hier or skin)",
         ),
         (
             load("m.obj", options(&dir, Some("empty.json"), None)),

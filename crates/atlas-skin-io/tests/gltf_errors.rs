@@ -5,7 +5,6 @@ mod gltf_support;
 
 use atlas_skin_io::gltf::{self, WriteOptions};
 use atlas_skin_io::IoError;
-use atlas_skin_runtime::random_pose::SplitMix64;
 use gltf_support::{model_path, out_dir};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
@@ -277,22 +276,10 @@ fn damaged_files_never_panic() {
     let dir = out_dir("fuzz");
     let glb = riggedsimple_glb();
     let gltf_text = std::fs::read(model_path("simpleskin", "SimpleSkin.gltf")).unwrap();
-    let mut rng = SplitMix64::new(2008);
     let mut checked = 0;
     for (name, original) in [("fuzz.glb", &glb), ("fuzz.gltf", &gltf_text)] {
         let path: &Path = &dir.join(name);
-        let mut variants: Vec<Vec<u8>> = (1..original.len())
-            .step_by(original.len() / 200 + 1)
-            .map(|n| original[..n].to_vec())
-            .collect();
-        for _ in 0..600 {
-            let mut bytes = original.clone();
-            for _ in 0..1 + rng.next_u64() % 4 {
-                let at = (rng.next_u64() % bytes.len() as u64) as usize;
-                bytes[at] ^= 1 << (rng.next_u64() % 8);
-            }
-            variants.push(bytes);
-        }
+        let variants = atlas_skin_corpus::damaged_copies(original, 200, 600, 2008);
         for bytes in variants {
             std::fs::write(path, &bytes).unwrap();
             if let Err(error) = gltf::read(path) {

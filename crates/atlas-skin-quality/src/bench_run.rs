@@ -320,6 +320,7 @@ pub(crate) mod tests {
                     matched: 100,
                     candidate_vertices: 100,
                     candidate_joints: 5,
+                    joint_matches: Vec::new(),
                     weights_l1: WeightsL1 {
                         mean: 0.5,
                         p95: 1.0,

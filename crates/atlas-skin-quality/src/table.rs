@@ -256,6 +256,7 @@ mod tests {
             matched: 10,
             candidate_vertices: 10,
             candidate_joints: 2,
+            joint_matches: Vec::new(),
             weights_l1: WeightsL1 {
                 mean: 0.1,
                 p95: 0.2,

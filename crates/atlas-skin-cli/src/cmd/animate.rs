@@ -64,17 +64,45 @@ pub fn animate_glb_bytes(input: &Path, bvh: &Path, joint_map: Option<&Path>) -> 
         .with_context(|| format!("cannot load {}", input.display()))?;
     let motion = BvhMotion::read(bvh, joint_map)?;
     let (weights, options) = animation_options(&character, &motion)?;
+    glb_bytes(&character, weights, &options).context("cannot write the animated glb")
+}
+
+/// The skinned glb of any input with weights (a glb as it is; other formats, e.g. FBX,
+/// written with their own weights), for the viewer.
+pub fn skinned_glb_bytes(input: &Path) -> Result<Vec<u8>> {
+    if input
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
+    {
+        return std::fs::read(input).with_context(|| format!("reading {}", input.display()));
+    }
+    let character = atlas_skin_io::load_character(input, &Default::default())
+        .with_context(|| format!("cannot load {}", input.display()))?;
+    let weights = character.reference_weights.as_ref().with_context(|| {
+        format!(
+            "{} has no skin weights: skin it first (atlas-skin skin)",
+            input.display()
+        )
+    })?;
+    glb_bytes(&character, weights, &WriteOptions::default())
+}
+
+/// The bytes of the glb [`write_skinned_glb`] writes for `character` with `weights`.
+fn glb_bytes(
+    character: &Character,
+    weights: &atlas_skin_runtime::VertexWeights,
+    options: &WriteOptions,
+) -> Result<Vec<u8>> {
     // The writer writes files; a private temporary file turns it into bytes.
     let temporary = std::env::temp_dir().join(format!(
-        "atlas-skin-animate-{}-{}.glb",
+        "atlas-skin-glb-{}-{}.glb",
         std::process::id(),
         std::time::SystemTime::now()
             .duration_since(std::time::UNIX_EPOCH)
             .map_or(0, |d| d.as_nanos())
     ));
-    write_skinned_glb(&character, weights, &options, &temporary)
-        .context("cannot write the animated glb")?;
-    let bytes = std::fs::read(&temporary).context("cannot read back the animated glb");
+    write_skinned_glb(character, weights, options, &temporary)?;
+    let bytes = std::fs::read(&temporary).context("cannot read back the written glb");
     // Best effort: a leftover file in the temporary directory is harmless.
     let _ = std::fs::remove_file(&temporary);
     bytes

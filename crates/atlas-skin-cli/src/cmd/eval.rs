@@ -4,6 +4,7 @@
 
 use crate::input::{InputArgs, Prepared, ReadArgs};
 use anyhow::{Context, Result};
+use atlas_skin_eval::matching::{JointMatch, JointPair};
 use atlas_skin_eval::{evaluate, Animation, EvalInput, EvalOptions, Evaluation, Weighted};
 use atlas_skin_io::{Character, LoadOptions};
 use std::path::PathBuf;
@@ -11,11 +12,13 @@ use std::path::PathBuf;
 /// Arguments.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// The reference character with its weights: .glb/.gltf/.vrm, or a mesh with
-    /// --skeleton and --weights.
+    /// The reference character with its weights: .glb/.gltf/.vrm, .fbx, or a mesh with
+    /// --skeleton and --weights (or an OBJ with RigNet's --skeleton X_rig.txt).
     pub reference: PathBuf,
-    /// The candidate: a skinned .glb/.gltf of the same mesh, joints named as the
-    /// reference's.
+    /// The candidate: a skinned file (.glb/.gltf/.vrm, .fbx) of the same character, e.g.
+    /// another tool's export. Joints are matched by name, then by name ignoring case and
+    /// punctuation, then by bind position; vertices by position (seams may be split
+    /// differently).
     pub candidate: PathBuf,
     /// How to read the reference (--skeleton, --group, --weights).
     #[command(flatten)]
@@ -58,7 +61,32 @@ pub fn run(args: Args) -> Result<()> {
         worst: args.worst,
         ..EvalOptions::default()
     };
-    let evaluation = compare(&reference, &candidate, &options)?;
+    let mut evaluation = compare(&reference, &candidate, &options);
+    if !evaluation
+        .as_ref()
+        .is_ok_and(|e| 2 * e.matched >= e.vertices)
+    {
+        // Another tool may export the mesh in the scene's space rather than the skin's
+        // bind space (Blender bakes a glTF's root rotation in): compare both at rest.
+        if let (Some(placed_reference), Some(placed_candidate)) = (
+            placed_at_rest(&reference.character),
+            placed_at_rest(&candidate),
+        ) {
+            let placed = compare(
+                &Prepared::new(placed_reference),
+                &placed_candidate,
+                &options,
+            );
+            if placed.as_ref().is_ok_and(|e| 2 * e.matched >= e.vertices) {
+                eprintln!(
+                    "warning: the two files' bind spaces differ; compared both in the placement \
+                     their node trees give them at rest"
+                );
+                evaluation = placed;
+            }
+        }
+    }
+    let evaluation = evaluation?;
     if evaluation.matched < evaluation.vertices {
         eprintln!(
             "warning: {} of {} reference vertices have no candidate vertex at their position; \
@@ -104,6 +132,35 @@ fn compare(
     })
 }
 
+/// `character` moved from its skin's bind space into the placement its node tree gives it
+/// at rest: `T = W₀ · IBM₀`, the rest world matrix of joint 0 times its inverse bind
+/// matrix (the identity when the bind pose is the rest pose in the same space). Positions
+/// become `T · p` and inverse binds `IBM_j · T⁻¹`, so every joint's bind world becomes
+/// `T · B_j` and skinning with the rig's world matrices is unchanged. `None` without a
+/// skeleton and rig, or when T is not invertible.
+fn placed_at_rest(character: &Character) -> Option<Character> {
+    let (skeleton, rig) = (character.skeleton.as_ref()?, character.rig.as_ref()?);
+    rig.validate().ok()?;
+    let mut node_world = vec![glam::Mat4::IDENTITY; rig.len()];
+    rig.world(&rig.rest, &mut node_world);
+    let root_node = *rig.joint_nodes.first()? as usize;
+    let placement = node_world[root_node] * *skeleton.inverse_bind.first()?;
+    if placement.determinant().abs() < f32::EPSILON || !placement.is_finite() {
+        return None;
+    }
+    let mut placed = character.clone();
+    for p in &mut placed.mesh.positions {
+        *p = placement.transform_point3(*p);
+    }
+    let inverse = placement.inverse();
+    if let Some(skeleton) = placed.skeleton.as_mut() {
+        for m in &mut skeleton.inverse_bind {
+            *m *= inverse;
+        }
+    }
+    Some(placed)
+}
+
 /// The mesh, skeleton and weights of `character`, which must have the last two.
 fn weighted<'a>(character: &'a Character, role: &str) -> Result<Weighted<'a>> {
     let path = character.path.display();
@@ -137,6 +194,7 @@ fn summary(e: &Evaluation) -> String {
             "vertices {} (matched {}), joints {}; candidate: {} vertices, {} joints\n",
             e.vertices, e.matched, e.joints, e.candidate_vertices, e.candidate_joints
         ),
+        joint_matches(&e.joint_matches),
         format!(
             "{:<22} mean {:.3}  p95 {:.3}  max {:.3}  dominant joint agrees {:.1}%\n",
             "weights L1",
@@ -162,6 +220,30 @@ fn summary(e: &Evaluation) -> String {
     .into_iter()
     .chain(e.worst_vertices.iter().map(worst_line))
     .collect()
+}
+
+/// How the candidate's joints were matched: counts, then every pair not matched by the
+/// same name.
+fn joint_matches(pairs: &[JointPair]) -> String {
+    let count = |how| pairs.iter().filter(|p| p.how == how).count();
+    let mut text = format!(
+        "{:<22} {} by name, {} ignoring case and punctuation, {} by bind position\n",
+        "joints matched",
+        count(JointMatch::Name),
+        count(JointMatch::NameIgnoringCase),
+        count(JointMatch::Position)
+    );
+    for pair in pairs.iter().filter(|p| p.how != JointMatch::Name) {
+        let how = match pair.how {
+            JointMatch::NameIgnoringCase => "name ignoring case and punctuation",
+            _ => "bind position",
+        };
+        text += &format!(
+            "  candidate {:?} -> reference {:?} ({how})\n",
+            pair.candidate, pair.reference
+        );
+    }
+    text
 }
 
 /// One line of the worst-vertex list: each joint's weight, and after `@` how many times

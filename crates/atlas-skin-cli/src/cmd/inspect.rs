@@ -4,6 +4,7 @@
 use crate::input::{InputArgs, Prepared};
 use anyhow::Result;
 use atlas_skin::mesh::winding::is_inside;
+use atlas_skin_io::PartBinding;
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -35,6 +36,10 @@ pub fn run(args: Args) -> Result<()> {
 #[derive(Debug, Serialize)]
 pub struct Report {
     pub input: String,
+    /// How units and axes were converted on reading (FBX), if they were.
+    pub space: Option<String>,
+    /// The meshes of a multi-mesh input (FBX), empty for other formats.
+    pub parts: Vec<PartReport>,
     /// Stored vertices some triangle references.
     pub vertices: usize,
     pub welded_vertices: usize,
@@ -69,6 +74,16 @@ pub struct JointReport {
     pub tail: Option<[f32; 3]>,
 }
 
+/// One mesh of a multi-mesh input: its name, counts and how it follows the skeleton
+/// (`skinned`, `rigid` with its joint, or `unbound`).
+#[derive(Debug, Serialize)]
+pub struct PartReport {
+    pub name: String,
+    pub vertices: usize,
+    pub triangles: usize,
+    pub binding: String,
+}
+
 #[derive(Debug, Serialize)]
 pub struct ClipReport {
     pub name: String,
@@ -101,6 +116,28 @@ impl Report {
         };
         Self {
             input: character.path.display().to_string(),
+            space: character.space.clone(),
+            parts: character
+                .parts
+                .iter()
+                .map(|part| PartReport {
+                    name: part.name.clone(),
+                    vertices: part.vertices.len(),
+                    triangles: part.triangles.len(),
+                    binding: match part.binding {
+                        PartBinding::Skinned => "skinned".into(),
+                        PartBinding::Rigid { joint } => format!(
+                            "rigid on {}",
+                            character
+                                .skeleton
+                                .as_ref()
+                                .and_then(|s| s.names.get(joint as usize))
+                                .map_or("?", String::as_str)
+                        ),
+                        PartBinding::Unbound => "unbound".into(),
+                    },
+                })
+                .collect(),
             vertices: prepared.welded.referenced_stored,
             welded_vertices: prepared.welded.mesh.vertex_count(),
             triangles: stats.triangles,
@@ -135,8 +172,20 @@ impl Report {
             .genus
             .map_or("- (open surface)".to_string(), |g| g.to_string());
         let inside = self.joints.iter().filter(|j| j.inside).count();
-        let mut lines = vec![
-            format!("input:                 {}", self.input),
+        let mut lines = vec![format!("input:                 {}", self.input)];
+        if let Some(space) = &self.space {
+            lines.push(format!("units and axes:        {space}"));
+        }
+        if !self.parts.is_empty() {
+            lines.push(format!("meshes:                {}", self.parts.len()));
+        }
+        for part in &self.parts {
+            lines.push(format!(
+                "  {:?}: {} vertices, {} triangles, {}",
+                part.name, part.vertices, part.triangles, part.binding
+            ));
+        }
+        lines.extend([
             format!(
                 "vertices:              {} stored, {} welded",
                 self.vertices, self.welded_vertices
@@ -162,7 +211,7 @@ impl Report {
                 "joints:                {} ({inside} inside the surface)",
                 self.joints.len()
             ),
-        ];
+        ]);
         for (depth, joint) in self.joint_tree() {
             let [x, y, z] = joint.position;
             let flag = if joint.inside { "inside " } else { "OUTSIDE" };

@@ -9,7 +9,8 @@ pub use crate::html::write_html;
 /// Arguments.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Skinned glTF binary (.glb), for example the output of `atlas-skin skin`.
+    /// A skinned character: a glTF binary (.glb), for example the output of `atlas-skin
+    /// skin`, or any input with weights (e.g. .fbx).
     pub input: PathBuf,
     /// Skinning report JSON (`atlas-skin skin --report R.json`) shown in the side panel.
     #[arg(long, value_name = "R.json")]
@@ -34,8 +35,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             crate::cmd::animate::animate_glb_bytes(&args.input, bvh, args.joint_map.as_deref())
                 .with_context(|| format!("putting the motion {} on the character", bvh.display()))?
         }
-        None => std::fs::read(&args.input)
-            .with_context(|| format!("reading {}", args.input.display()))?,
+        None => crate::cmd::animate::skinned_glb_bytes(&args.input)?,
     };
     let report = args.report.as_deref().map(read_report).transpose()?;
     write_html(&glb, report.as_ref(), &args.output)

@@ -57,6 +57,23 @@ pub struct Args {
     /// Write a self-contained HTML report with an interactive view of the result.
     #[arg(long, value_name = "R.html")]
     pub html: Option<PathBuf>,
+    /// Also write the weights (as in the glb: the largest --max-influences, renormalised)
+    /// and the skeleton in RigNet's rig_info text format; `skin` lines number the vertices
+    /// as the mesh file does (OBJ order).
+    #[arg(long, value_name = "OUT.txt")]
+    pub rig_info: Option<PathBuf>,
+}
+
+/// The files a command reads: the input and its skeleton and weights files.
+fn input_files(input: &InputArgs) -> impl Iterator<Item = &Path> {
+    [
+        input.input.as_ref(),
+        input.read.skeleton.as_ref(),
+        input.read.weights.as_ref(),
+    ]
+    .into_iter()
+    .flatten()
+    .map(PathBuf::as_path)
 }
 
 /// `--blend` values.
@@ -86,6 +103,9 @@ pub fn run(args: Args) -> Result<()> {
             character.path.display()
         );
     };
+    if let Some(path) = &args.rig_info {
+        atlas_skin_io::check_not_input(path, input_files(&args.input))?;
+    }
     let mut timings = serde_json::Map::new();
     let progress = progress_bar();
     let skinned = skin(
@@ -111,12 +131,20 @@ pub fn run(args: Args) -> Result<()> {
     };
     write_skinned_glb(&character, &skinned.weights, &options, &args.output)?;
     timings.insert("write".into(), json!(start.elapsed().as_secs_f64() * 1e3));
+    let rig_info = args.rig_info.as_ref().map(|path| {
+        let pruned = skinned.weights.pruned(params.max_influences);
+        let text = atlas_skin_io::rig_info::to_text(&skeleton, &pruned, &character.file_vertex);
+        (path, text)
+    });
     progress.finish_and_clear();
 
     let report = report(&character, &skinned, timings);
     if let Some(path) = &args.report {
         let text = serde_json::to_string_pretty(&report)?;
-        atlas_skin_io::write_atomically(path, Some(&character.path), text.as_bytes())?;
+        atlas_skin_io::write_atomically(path, Some(character.path.as_path()), text.as_bytes())?;
+    }
+    if let Some((path, text)) = &rig_info {
+        atlas_skin_io::write_atomically(path, input_files(&args.input), text.as_bytes())?;
     }
     if let Some(path) = &args.debug_glb {
         write_debug(&skinned, path)?;

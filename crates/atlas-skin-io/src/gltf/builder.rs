@@ -124,14 +124,19 @@ impl GlbBuilder {
     ) -> (usize, usize) {
         let flat: Vec<f32> = positions.iter().flat_map(|p| p.to_array()).collect();
         let position = self.push_f32_accessor(&flat, "VEC3", true, Some(ARRAY_BUFFER));
+        (position, self.push_indices(triangles, positions.len()))
+    }
+
+    /// Appends `triangles` over `vertex_count` vertices as an index accessor of the smallest
+    /// allowed type and returns it.
+    pub fn push_indices(&mut self, triangles: &[[u32; 3]], vertex_count: usize) -> usize {
         let flat_indices: Vec<u32> = triangles.iter().flatten().copied().collect();
-        let indices = self.push_uint_accessor(
+        self.push_uint_accessor(
             &flat_indices,
-            index_component(positions.len()),
+            index_component(vertex_count),
             "SCALAR",
             Some(ELEMENT_ARRAY_BUFFER),
-        );
-        (position, indices)
+        )
     }
 
     /// Appends unsigned integer `values` (flattened elements of `type_name`) stored as

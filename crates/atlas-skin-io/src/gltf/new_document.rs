@@ -12,7 +12,9 @@ use std::path::Path;
 /// The `.glb` bytes of a document with one skinned mesh and the skeleton as joint nodes.
 ///
 /// - Mesh: the vertices used by a triangle, in stored order (so their weight rows keep
-///   their order), POSITION with min/max, smooth NORMAL, indices, JOINTS_n/WEIGHTS_n.
+///   their order), POSITION with min/max, smooth NORMAL, JOINTS_n/WEIGHTS_n, one
+///   primitive (indices) per material of the character ([`Character::materials`]: base
+///   colour, not metallic), or one without material.
 /// - Joints: nodes 0..#J named as in the skeleton, with the rest local transform
 ///   `bind_world[parent]⁻¹ · bind_world[j]` as T/R/S; the skin's inverseBindMatrices are the
 ///   skeleton's; `skin.skeleton` is the root joint when there is one root.
@@ -60,7 +62,8 @@ pub(crate) fn new_document(
     );
     let flat =
         |vectors: &[Vec3]| -> Vec<f32> { vectors.iter().flat_map(|p| p.to_array()).collect() };
-    let (position, indices) = builder.push_triangle_mesh(&positions, &triangles);
+    let position_values: Vec<f32> = flat(&positions);
+    let position = builder.push_f32_accessor(&position_values, "VEC3", true, Some(ARRAY_BUFFER));
     let normals = smooth_normals(&positions, &triangles);
     let normal = builder.push_f32_accessor(&flat(&normals), "VEC3", false, Some(ARRAY_BUFFER));
     let packed = pack_weights(weights, kept.iter().copied(), options.max_influences);
@@ -70,15 +73,33 @@ pub(crate) fn new_document(
         attributes[format!("JOINTS_{set}")] = json!(joints);
         attributes[format!("WEIGHTS_{set}")] = json!(weights);
     }
+    let mut primitives = Vec::new();
+    for (material, group) in material_groups(character, &triangles) {
+        let indices = builder.push_indices(&group, positions.len());
+        let mut primitive = json!({"attributes": attributes, "indices": indices});
+        if let Some(material) = material {
+            primitive["material"] = json!(material);
+        }
+        primitives.push(primitive);
+    }
+    for material in &character.materials {
+        builder.push_item(
+            "materials",
+            json!({
+                "name": material.name,
+                "pbrMetallicRoughness": {
+                    "baseColorFactor": material.base_color,
+                    "metallicFactor": 0.0,
+                },
+            }),
+        );
+    }
     let name = character
         .path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "mesh".into());
-    builder.push_item(
-        "meshes",
-        json!({"name": name, "primitives": [{"attributes": attributes, "indices": indices}]}),
-    );
+    builder.push_item("meshes", json!({"name": name, "primitives": primitives}));
 
     let children = skeleton.children();
     for (j, local) in skeleton.rest_local().iter().enumerate() {
@@ -122,6 +143,25 @@ pub(crate) fn new_document(
         merge_asset_extras(builder.json_mut(), extras);
     }
     Ok(builder.finish())
+}
+
+/// The triangles of each material in order of first use (`None`: no material); all
+/// triangles in one group when the character has no materials (or not one per triangle).
+fn material_groups(
+    character: &Character,
+    triangles: &[[u32; 3]],
+) -> Vec<(Option<u32>, Vec<[u32; 3]>)> {
+    if character.materials.is_empty() || character.triangle_materials.len() != triangles.len() {
+        return vec![(None, triangles.to_vec())];
+    }
+    let mut groups: Vec<(Option<u32>, Vec<[u32; 3]>)> = Vec::new();
+    for (&material, &triangle) in character.triangle_materials.iter().zip(triangles) {
+        match groups.iter_mut().find(|(m, _)| *m == material) {
+            Some((_, group)) => group.push(triangle),
+            None => groups.push((material, vec![triangle])),
+        }
+    }
+    groups
 }
 
 /// Smooth vertex normals: `n_v = normalize(Σ_{t ∋ v} (p_b − p_a) × (p_c − p_a))`, the

@@ -1,6 +1,7 @@
 //! The node hierarchy of a glTF document: parents, local transforms, names.
 
 use super::document::{opt_str, Document};
+use crate::names::unique_names;
 use crate::IoError;
 use atlas_skin_runtime::Trs;
 use glam::{Mat4, Quat, Vec3};
@@ -113,21 +114,17 @@ pub(crate) fn unique_node_names(doc: &Document, first: &[usize]) -> Result<Vec<S
             .map(str::to_string)
             .unwrap_or_else(|| format!("node{index}"))
     };
-    let mut names = vec![String::new(); nodes.len()];
-    let mut taken = HashSet::new();
     let first_set: HashSet<usize> = first.iter().copied().collect();
-    let order = first
+    let order: Vec<usize> = first
         .iter()
         .copied()
-        .chain((0..nodes.len()).filter(|i| !first_set.contains(i)));
-    for index in order {
-        let wanted = base(index);
-        let mut name = wanted.clone();
-        let mut suffix = 0;
-        while !taken.insert(name.clone()) {
-            suffix += 1;
-            name = format!("{wanted}.{suffix}");
-        }
+        .chain((0..nodes.len()).filter(|i| !first_set.contains(i)))
+        .collect();
+    let mut names = vec![String::new(); nodes.len()];
+    for (&index, name) in order
+        .iter()
+        .zip(unique_names(order.iter().map(|&i| base(i)).collect()))
+    {
         names[index] = name;
     }
     Ok(names)

@@ -81,7 +81,7 @@ pub fn write_skinned_glb(
         }
         _ => new_document(character, skeleton, weights, options, out)?,
     };
-    write_atomically(out, Some(&character.path), &bytes)
+    write_atomically(out, Some(character.path.as_path()), &bytes)
 }
 
 /// Skin weights packed into glTF's fixed-width JOINTS_n/WEIGHTS_n sets.
