@@ -20,6 +20,8 @@ pub enum IoError {
     },
     #[error("{}: is a directory, not a file", path.display())]
     IsDirectory { path: PathBuf },
+    #[error("{}: not a regular file (a device, FIFO or socket)", path.display())]
+    NotARegularFile { path: PathBuf },
     #[error("{}: the file is empty", path.display())]
     Empty { path: PathBuf },
     #[error("{}: unsupported file type {extension:?} (expected {expected})", path.display())]

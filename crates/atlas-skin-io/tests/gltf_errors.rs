@@ -6,7 +6,7 @@ mod gltf_support;
 use atlas_skin_io::gltf::{self, WriteOptions};
 use atlas_skin_io::IoError;
 use atlas_skin_runtime::random_pose::SplitMix64;
-use gltf_support::{model_path, out_dir};
+use gltf_support::{model_path, out_dir, simpleskin};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 
@@ -31,20 +31,6 @@ fn kind_matches(error: &IoError, kind: Kind) -> bool {
 
 fn riggedsimple_glb() -> Vec<u8> {
     std::fs::read(model_path("riggedsimple", "RiggedSimple.glb")).unwrap()
-}
-
-/// SimpleSkin.gltf's JSON with its (embedded) buffer 0 decoded.
-fn simpleskin() -> (Value, Vec<u8>) {
-    use base64::Engine;
-    let json: Value = serde_json::from_slice(
-        &std::fs::read(model_path("simpleskin", "SimpleSkin.gltf")).unwrap(),
-    )
-    .unwrap();
-    let uri = json["buffers"][0]["uri"].as_str().unwrap();
-    let buffer0 = base64::engine::general_purpose::STANDARD
-        .decode(uri.split_once(',').unwrap().1)
-        .unwrap();
-    (json, buffer0)
 }
 
 /// SimpleSkin with buffer 0 replaced by `buffer0`.

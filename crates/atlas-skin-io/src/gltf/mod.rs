@@ -11,6 +11,7 @@ mod builder;
 mod container;
 mod debug;
 mod document;
+mod file_access;
 mod new_document;
 mod nodes;
 mod prune;
@@ -19,6 +20,7 @@ mod rewrite;
 mod view_span;
 mod write;
 
+pub use container::{ImageBytes, MAX_LOADED_BYTES};
 pub use debug::write_debug_glb;
 pub use read::read;
 pub use write::{write_skinned_glb, WriteOptions};
@@ -30,12 +32,15 @@ use std::ops::Range;
 ///
 /// - `document`: the whole JSON document, untouched.
 /// - `buffers`: the bytes of every buffer, in `document.buffers` order.
+/// - `images`: the bytes of every image given by `uri`, in `document.images` order; `None`
+///   for images in a bufferView and for those the reader left out (with a warning).
 /// - `skin`: the skin whose joints are the character's skeleton, if any.
 /// - `primitives`: every primitive read into `Character::mesh`, in mesh order.
 #[derive(Clone)]
 pub struct GltfSource {
     pub document: Value,
     pub buffers: Vec<Vec<u8>>,
+    pub images: Vec<Option<ImageBytes>>,
     pub skin: Option<usize>,
     pub primitives: Vec<PrimitiveSource>,
 }

@@ -77,6 +77,7 @@ pub fn read(path: &Path) -> Result<Character, IoError> {
         primitives: geometry.primitives,
         document: container.json,
         buffers: container.buffers,
+        images: container.images,
     });
     Ok(character)
 }

@@ -2,7 +2,6 @@
 
 use super::animation::append_clips;
 use super::builder::GlbBuilder;
-use super::container::load_uri;
 use super::prune::{drop_orphans, References};
 use super::write::{merge_asset_extras, pack_weights, push_weight_accessors, WriteOptions};
 use super::GltfSource;
@@ -39,7 +38,7 @@ pub(crate) fn rewrite_document(
     let mut builder = GlbBuilder::new(json);
     let input_references = References::of_input(builder.json_mut());
     copy_buffer_views(&mut builder, source, input)?;
-    embed_images(&mut builder, input)?;
+    embed_images(&mut builder, source, input)?;
 
     let joint_nodes = skin_joint_nodes(&source.document, source.skin, input)?;
     let joint_count = character.skeleton.as_ref().map_or(0, |s| s.len());
@@ -107,19 +106,31 @@ fn copy_buffer_views(
     Ok(())
 }
 
-/// Embeds every image given by URI (a file beside the input or a `data:` URI) as a
-/// bufferView with its `mimeType`.
-fn embed_images(builder: &mut GlbBuilder, input: &Path) -> Result<(), IoError> {
-    let Some(Value::Array(mut images)) = builder.json_mut().remove("images") else {
+/// Embeds every image given by URI (read with the document: a file beside the input or a
+/// `data:` URI) as a bufferView with its `mimeType`. Images the reader left out are
+/// removed, with the textures' `source` references renumbered (a texture whose image was
+/// left out keeps no `source`).
+fn embed_images(
+    builder: &mut GlbBuilder,
+    source: &GltfSource,
+    input: &Path,
+) -> Result<(), IoError> {
+    let Some(Value::Array(images)) = builder.json_mut().remove("images") else {
         return Ok(());
     };
-    for (index, image) in images.iter_mut().enumerate() {
+    let mut kept = Vec::with_capacity(images.len());
+    let mut new_index = Vec::with_capacity(images.len());
+    for (index, mut image) in images.into_iter().enumerate() {
         let Some(uri) = image.get("uri").and_then(Value::as_str).map(str::to_string) else {
+            new_index.push(Some(kept.len()));
+            kept.push(image);
             continue;
         };
-        let (bytes, declared_type) = load_uri(input, &uri)
-            .map_err(|e| IoError::invalid(input, format!("images[{index}]: {e}")))?;
-        let mime_type = sniff_image_type(&bytes)
+        let Some(Some(read)) = source.images.get(index) else {
+            new_index.push(None);
+            continue;
+        };
+        let mime_type = sniff_image_type(&read.bytes)
             .map(str::to_string)
             .or_else(|| {
                 image
@@ -127,24 +138,60 @@ fn embed_images(builder: &mut GlbBuilder, input: &Path) -> Result<(), IoError> {
                     .and_then(Value::as_str)
                     .map(str::to_string)
             })
-            .or(declared_type)
+            .or_else(|| read.media_type.clone())
             .ok_or_else(|| {
                 IoError::invalid(
                     input,
                     format!("images[{index}] ({uri}) has an unknown type"),
                 )
             })?;
-        let view = builder.push_view(&bytes, None);
-        if let Value::Object(image) = image {
-            image.remove("uri");
-            image.insert("bufferView".into(), json!(view));
-            image.insert("mimeType".into(), json!(mime_type));
+        let view = builder.push_view(&read.bytes, None);
+        if let Value::Object(object) = &mut image {
+            object.remove("uri");
+            object.insert("bufferView".into(), json!(view));
+            object.insert("mimeType".into(), json!(mime_type));
+        }
+        new_index.push(Some(kept.len()));
+        kept.push(image);
+    }
+    if let Some(Value::Array(textures)) = builder.json_mut().get_mut("textures") {
+        for texture in textures {
+            renumber_image_sources(texture, &new_index);
         }
     }
     builder
         .json_mut()
-        .insert("images".into(), Value::Array(images));
+        .insert("images".into(), Value::Array(kept));
     Ok(())
+}
+
+/// Renumbers the `source` of a texture and of its extensions (`EXT_texture_webp`,
+/// `KHR_texture_basisu`, ...) by `new_index`, removing a `source` whose image is gone.
+fn renumber_image_sources(texture: &mut Value, new_index: &[Option<usize>]) {
+    let Value::Object(object) = texture else {
+        return;
+    };
+    let renumber = |object: &mut Map<String, Value>| {
+        let Some(old) = object.get("source").and_then(Value::as_u64) else {
+            return;
+        };
+        match new_index.get(old as usize).copied().flatten() {
+            Some(new) => {
+                object.insert("source".into(), json!(new));
+            }
+            None => {
+                object.remove("source");
+            }
+        }
+    };
+    renumber(object);
+    if let Some(Value::Object(extensions)) = object.get_mut("extensions") {
+        for extension in extensions.values_mut() {
+            if let Value::Object(extension) = extension {
+                renumber(extension);
+            }
+        }
+    }
 }
 
 /// The media type of image bytes recognised by their signature.
