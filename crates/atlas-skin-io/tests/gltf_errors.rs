@@ -175,6 +175,26 @@ fn broken_files() -> Vec<(&'static str, Vec<u8>, Kind, &'static str)> {
             "less than its byteLength",
         ),
         (
+            // 100 channels each reading 1M zero key times and translations (16 MB): 1.6 GB
+            // from a tiny file.
+            "budget.gltf",
+            edited(&|j| {
+                let accessors = j["accessors"].as_array_mut().unwrap();
+                let times = accessors.len();
+                accessors.push(json!({"componentType": 5126, "count": 1 << 20, "type": "SCALAR"}));
+                accessors.push(json!({"componentType": 5126, "count": 1 << 20, "type": "VEC3"}));
+                let channels: Vec<Value> = (0..100)
+                    .map(|_| json!({"sampler": 0, "target": {"node": 0, "path": "translation"}}))
+                    .collect();
+                j["animations"] = json!([{
+                    "samplers": [{"input": times, "output": times + 1}],
+                    "channels": channels
+                }]);
+            }),
+            Kind::Invalid,
+            "budget",
+        ),
+        (
             "cycle.gltf",
             edited(&|j| {
                 j["nodes"][0]["children"] = json!([]);

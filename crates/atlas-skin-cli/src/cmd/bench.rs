@@ -14,7 +14,7 @@
 
 use super::pose::{Posable, POSE_INFLUENCES};
 use crate::input::InputArgs;
-use anyhow::{ensure, Context, Result};
+use anyhow::{Context, Result};
 use atlas_skin_runtime::random_pose::random_rotations;
 use atlas_skin_runtime::skinning_job::PARALLEL_CHUNK;
 use atlas_skin_runtime::{
@@ -66,13 +66,16 @@ pub struct Args {
     #[command(flatten)]
     pub input: InputArgs,
     /// Worker threads (1 = the sequential path).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1,
+          value_parser = crate::counts::count_between(1, crate::counts::MAX_THREADS))]
     pub threads: usize,
     /// Replicate the mesh to this many vertices (default: the mesh as is).
-    #[arg(long)]
+    #[arg(long,
+          value_parser = crate::counts::count_between(1, crate::counts::MAX_BENCH_VERTICES))]
     pub vertices: Option<usize>,
     /// Frames timed per method.
-    #[arg(long, default_value_t = 200)]
+    #[arg(long, default_value_t = 200,
+          value_parser = crate::counts::count_between(1, crate::counts::MAX_BENCH_FRAMES))]
     pub frames: usize,
     /// Print the figures as one JSON object.
     #[arg(long)]
@@ -100,8 +103,6 @@ pub struct BenchReport {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    ensure!(args.threads >= 1, "--threads must be at least 1");
-    ensure!(args.frames >= 1, "--frames must be at least 1");
     let character = args.input.load_skinned()?;
     let posable = Posable::new(&character)?;
     let weights = character
@@ -109,7 +110,6 @@ pub fn run(args: Args) -> Result<()> {
         .as_ref()
         .context("the character has no skin weights")?;
     let count = args.vertices.unwrap_or(posable.rest_positions.len());
-    ensure!(count >= 1, "--vertices must be at least 1");
     let mut streams = Streams::replicate(&posable, weights, count)?;
     let palettes: Vec<Vec<Mat4>> = (0..POSES as u64)
         .map(|seed| {

@@ -35,7 +35,7 @@ pub struct Args {
     #[command(flatten)]
     pub source: PoseSource,
     /// Seconds into the animation, with --anim.
-    #[arg(long, default_value_t = 0.0, requires = "anim")]
+    #[arg(long, default_value_t = 0.0, requires = "anim", value_parser = crate::counts::finite)]
     pub time: f32,
     /// Frame of the BVH motion (0 = first), with --bvh.
     #[arg(long, default_value_t = 0, requires = "bvh")]

@@ -2,8 +2,9 @@
 //! joints, regions, geodesic overlaps, blended weights: [`atlas_skin::pipeline::skin`]) and
 //! writes a skinned glTF binary, with an optional JSON report, debug view and HTML report.
 
+use crate::counts::{check_count, MAX_INFLUENCES};
 use crate::input::InputArgs;
-use anyhow::{bail, Context, Result};
+use anyhow::{anyhow, bail, Context, Result};
 use atlas_skin::blend::Blend;
 use atlas_skin::decomposition_report::{debug_colors, debug_lines};
 use atlas_skin::pipeline::{skin, SkinParams, Skinned, Stage};
@@ -50,7 +51,8 @@ pub struct Args {
     #[arg(long, value_name = "JOINT")]
     pub forbid: Vec<String>,
     /// Influences kept per vertex (the largest, renormalised).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N",
+          value_parser = crate::counts::count_between(1, crate::counts::MAX_INFLUENCES))]
     pub max_influences: Option<usize>,
     /// Write an unskinned glb with the regions as vertex colours and the cut curves.
     #[arg(long, value_name = "D.glb")]
@@ -191,6 +193,10 @@ fn params(args: &Args) -> Result<SkinParams> {
     }
     if let Some(n) = args.max_influences {
         params.max_influences = n;
+    }
+    if let Some(path) = &args.config {
+        check_count(params.max_influences, 1, MAX_INFLUENCES)
+            .map_err(|e| anyhow!("{}: max_influences {e}", path.display()))?;
     }
     params.decompose.force.extend(args.force.iter().cloned());
     params.decompose.forbid.extend(args.forbid.iter().cloned());

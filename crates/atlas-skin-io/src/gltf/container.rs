@@ -19,12 +19,14 @@ const UTF8_BOM: &[u8; 3] = b"\xEF\xBB\xBF";
 
 /// A glTF document as read: its JSON, the bytes of every buffer (in `buffers` order), of
 /// every image given by `uri` (in `images` order; `None` for the others and for those left
-/// out)) and warnings about tolerated departures from the format.
+/// out), warnings about tolerated departures from the format, and the bytes read in all
+/// (the file, its buffers and images).
 pub(crate) struct Container {
     pub json: Value,
     pub buffers: Vec<Vec<u8>>,
     pub images: Vec<Option<ImageBytes>>,
     pub warnings: Vec<String>,
+    pub input_bytes: u64,
 }
 
 /// Reads the `.glb`, `.vrm` or `.gltf` file at `path` and every buffer it refers to.
@@ -66,11 +68,13 @@ pub(crate) fn read_container(path: &Path) -> Result<Container, IoError> {
     let buffers = load_buffers(path, &json, bin, &mut folder)?;
     let buffer_bytes = buffers.iter().map(|b| b.len() as u64).sum();
     let images = load_images(path, &json, buffer_bytes, &mut folder, &mut warnings)?;
+    let image_bytes: u64 = images.iter().flatten().map(|i| i.bytes.len() as u64).sum();
     Ok(Container {
         json,
         buffers,
         images,
         warnings,
+        input_bytes: bytes.len() as u64 + buffer_bytes + image_bytes,
     })
 }
 

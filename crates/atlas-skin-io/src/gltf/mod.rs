@@ -7,6 +7,7 @@
 
 mod accessor;
 mod animation;
+mod budget;
 mod builder;
 mod container;
 mod debug;
@@ -20,10 +21,11 @@ mod rewrite;
 mod view_span;
 mod write;
 
+pub use budget::{DECODED_FLOOR_BYTES, DECODED_PER_INPUT_BYTE, MAX_DECODED_BYTES};
 pub use container::{ImageBytes, MAX_LOADED_BYTES};
 pub use debug::write_debug_glb;
 pub use read::read;
-pub use write::{write_skinned_glb, WriteOptions};
+pub use write::{write_skinned_glb, WriteOptions, MAX_INFLUENCES};
 
 use serde_json::Value;
 use std::ops::Range;

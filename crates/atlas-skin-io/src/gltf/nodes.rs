@@ -149,6 +149,7 @@ mod tests {
             json: &json,
             buffers: &[],
             path: Path::new("names.gltf"),
+            budget: &crate::gltf::budget::DecodeBudget::for_input(0),
         };
         let names = unique_node_names(&doc, &[1]).unwrap();
         assert_eq!(names, ["a.1", "a", "node2", "node2.1", "node4"]);

@@ -3,6 +3,7 @@
 
 use super::accessor::{read_floats, read_uints};
 use super::animation::{read_clips, read_rig};
+use super::budget::DecodeBudget;
 use super::container::read_container;
 use super::document::Document;
 use super::nodes::{unique_node_names, NodeTree};
@@ -32,10 +33,12 @@ use std::path::Path;
 /// JSON, out-of-range accessors or indices, non-finite positions, node cycles.
 pub fn read(path: &Path) -> Result<Character, IoError> {
     let mut container = read_container(path)?;
+    let budget = DecodeBudget::for_input(container.input_bytes);
     let doc = Document {
         json: &container.json,
         buffers: &container.buffers,
         path,
+        budget: &budget,
     };
     reject_compressed_geometry(&doc)?;
     let tree = NodeTree::new(&doc)?;
@@ -268,13 +271,18 @@ fn read_geometry<'a>(
                 Some(accessor) => {
                     read_uints(doc, accessor, "SCALAR", &format!("{location}.indices"))?
                 }
-                None => (0..vertex_count as u32).collect(),
+                None => {
+                    doc.charge(4 * vertex_count as u64, &location)?;
+                    (0..vertex_count as u32).collect()
+                }
             };
             if let Some(bad) = indices.iter().find(|&&i| i as usize >= vertex_count) {
                 return Err(doc.error(format!(
                     "{location}: index {bad} is out of range of its {vertex_count} vertices"
                 )));
             }
+            // A strip or fan makes 3 indices (12 bytes) of each index.
+            doc.charge(12 * indices.len() as u64, &location)?;
             let first_triangle = mesh.triangles.len();
             let offset = first as u32;
             mesh.triangles.extend(

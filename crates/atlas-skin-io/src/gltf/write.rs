@@ -11,11 +11,15 @@ use atlas_skin_runtime::{Clip, VertexWeights};
 use serde_json::{Map, Value};
 use std::path::Path;
 
+/// Largest [`WriteOptions::max_influences`]: 8 JOINTS_n/WEIGHTS_n sets, beyond what any
+/// engine skins with.
+pub const MAX_INFLUENCES: usize = 32;
+
 /// What the skinned writer adds to the document.
 #[derive(Debug, Clone)]
 pub struct WriteOptions {
     /// Largest number of joints per vertex (4 per JOINTS_n/WEIGHTS_n set; > 4 writes
-    /// JOINTS_1/WEIGHTS_1, ...). At least 1.
+    /// JOINTS_1/WEIGHTS_1, ...). From 1 to [`MAX_INFLUENCES`].
     pub max_influences: usize,
     /// Extra clips to add; `Track::node` is a skeleton joint index, mapped to the joint's
     /// node in the output.
@@ -59,8 +63,14 @@ pub fn write_skinned_glb(
     let skeleton = character.skeleton.as_ref().ok_or_else(|| {
         IoError::invalid(&character.path, "cannot write a skinned glTF: no skeleton")
     })?;
-    if options.max_influences == 0 {
-        return Err(IoError::invalid(out, "max_influences must be at least 1"));
+    if !(1..=MAX_INFLUENCES).contains(&options.max_influences) {
+        return Err(IoError::invalid(
+            out,
+            format!(
+                "max_influences is {}, outside 1..={MAX_INFLUENCES}",
+                options.max_influences
+            ),
+        ));
     }
     if weights.vertex_count() != character.mesh.positions.len() {
         return Err(IoError::invalid(
