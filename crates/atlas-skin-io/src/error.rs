@@ -42,8 +42,10 @@ pub enum IoError {
     Invalid { path: PathBuf, message: String },
     #[error("{}: invalid skeleton: {cause}", path.display())]
     Skeleton { path: PathBuf, cause: RuntimeError },
-    #[error("{}: refusing to write over the input file", path.display())]
-    WouldOverwriteInput { path: PathBuf },
+    #[error("{}: refusing to write over the input file {}", path.display(), input.display())]
+    WouldOverwriteInput { path: PathBuf, input: PathBuf },
+    #[error("{}: the same file as the output {}: one command cannot write it twice", path.display(), other.display())]
+    DuplicateOutput { path: PathBuf, other: PathBuf },
 }
 
 impl IoError {

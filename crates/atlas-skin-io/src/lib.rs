@@ -28,4 +28,4 @@ pub mod tgf;
 pub use character::{Character, LoadOptions, TriangleMesh};
 pub use error::IoError;
 pub use load::load_character;
-pub use output::write_atomically;
+pub use output::OutputPlan;

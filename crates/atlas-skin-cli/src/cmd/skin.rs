@@ -9,8 +9,8 @@ use atlas_skin::blend::Blend;
 use atlas_skin::decomposition_report::{debug_colors, debug_lines};
 use atlas_skin::pipeline::{skin, SkinParams, Skinned, Stage};
 use atlas_skin::{weld, BoundaryKind, Topology};
-use atlas_skin_io::gltf::{write_debug_glb, write_skinned_glb, WriteOptions};
-use atlas_skin_io::Character;
+use atlas_skin_io::gltf::{debug_glb, skinned_glb, WriteOptions};
+use atlas_skin_io::{Character, OutputPlan};
 use atlas_skin_runtime::Skeleton;
 use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -81,6 +81,16 @@ impl From<BlendArg> for Blend {
 }
 
 pub fn run(args: Args) -> Result<()> {
+    let outputs = [
+        Some(&args.output),
+        args.report.as_ref(),
+        args.debug_glb.as_ref(),
+    ]
+    .into_iter()
+    .chain([args.html.as_ref()])
+    .flatten()
+    .map(PathBuf::as_path);
+    let plan = OutputPlan::new(args.input.paths().chain(args.config.as_deref()), outputs)?;
     let mut params = params(&args)?;
     let character = args.input.load()?;
     let Some(skeleton) = character.skeleton.clone() else {
@@ -129,22 +139,21 @@ pub fn run(args: Args) -> Result<()> {
         max_influences: params.max_influences,
         ..WriteOptions::default()
     };
-    write_skinned_glb(&character, &skinned.weights, &options, &args.output)?;
+    let glb = skinned_glb(&character, &skinned.weights, &options, &args.output)?;
+    plan.write(&args.output, &glb)?;
     timings.insert("write".into(), ms(start));
     progress.finish_and_clear();
 
     let report = report(&character, &welded.welded_of_stored, &skinned, timings);
     if let Some(path) = &args.report {
         let text = serde_json::to_string_pretty(&report)?;
-        atlas_skin_io::write_atomically(path, Some(&character.path), text.as_bytes())?;
+        plan.write(path, text.as_bytes())?;
     }
     if let Some(path) = &args.debug_glb {
-        write_debug(&skinned, path)?;
+        plan.write(path, &debug_view(&skinned, path)?)?;
     }
     if let Some(path) = &args.html {
-        let glb = std::fs::read(&args.output)
-            .with_context(|| format!("cannot read back {}", args.output.display()))?;
-        crate::html::write_html(&glb, Some(&report), path)?;
+        crate::html::write_html(&glb, Some(&report), path, &plan)?;
     }
     let d = skinned.decomposition.report();
     println!(
@@ -315,15 +324,15 @@ fn report(
     })
 }
 
-/// The debug view: the split surface coloured by region, the cut curves as lines.
-fn write_debug(skinned: &Skinned, path: &Path) -> Result<()> {
+/// The debug view (a glb): the split surface coloured by region, the cut curves as lines.
+fn debug_view(skinned: &Skinned, path: &Path) -> Result<Vec<u8>> {
     let d = &skinned.decomposition;
     let positions: Vec<Vec3> = d.surface.positions.iter().map(|p| p.as_vec3()).collect();
     let lines: Vec<[Vec3; 2]> = debug_lines(d)
         .iter()
         .map(|[a, b]| [Vec3::from_array(*a), Vec3::from_array(*b)])
         .collect();
-    write_debug_glb(
+    debug_glb(
         &positions,
         &d.surface.triangles,
         &debug_colors(d),

@@ -23,9 +23,9 @@ mod write;
 
 pub use budget::{DECODED_FLOOR_BYTES, DECODED_PER_INPUT_BYTE, MAX_DECODED_BYTES};
 pub use container::{ImageBytes, MAX_LOADED_BYTES};
-pub use debug::write_debug_glb;
+pub use debug::debug_glb;
 pub use read::read;
-pub use write::{write_skinned_glb, WriteOptions, MAX_INFLUENCES};
+pub use write::{skinned_glb, write_skinned_glb, WriteOptions, MAX_INFLUENCES};
 
 use serde_json::Value;
 use std::ops::Range;

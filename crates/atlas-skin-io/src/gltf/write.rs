@@ -5,7 +5,7 @@ use super::accessor::ComponentType;
 use super::builder::{GlbBuilder, ARRAY_BUFFER};
 use super::new_document::new_document;
 use super::rewrite::rewrite_document;
-use crate::output::write_atomically;
+use crate::output::OutputPlan;
 use crate::{Character, IoError};
 use atlas_skin_runtime::{Clip, VertexWeights};
 use serde_json::{Map, Value};
@@ -60,6 +60,21 @@ pub fn write_skinned_glb(
     options: &WriteOptions,
     out: &Path,
 ) -> Result<(), IoError> {
+    let plan = OutputPlan::new([character.path.as_path()], [out])?;
+    plan.write(out, &skinned_glb(character, weights, options, out)?)
+}
+
+/// The bytes [`write_skinned_glb`] writes (`out` only names the output in errors), for
+/// callers that write through their own [`OutputPlan`].
+///
+/// # Errors
+/// As [`write_skinned_glb`], without the write errors.
+pub fn skinned_glb(
+    character: &Character,
+    weights: &VertexWeights,
+    options: &WriteOptions,
+    out: &Path,
+) -> Result<Vec<u8>, IoError> {
     let skeleton = character.skeleton.as_ref().ok_or_else(|| {
         IoError::invalid(&character.path, "cannot write a skinned glTF: no skeleton")
     })?;
@@ -85,13 +100,12 @@ pub fn write_skinned_glb(
     weights
         .validate(skeleton.len())
         .map_err(|e| IoError::invalid(out, format!("bad weights: {e}")))?;
-    let bytes = match character.gltf.as_ref() {
+    match character.gltf.as_ref() {
         Some(source) if source.skin.is_some() => {
-            rewrite_document(character, source, weights, options, out)?
+            rewrite_document(character, source, weights, options, out)
         }
-        _ => new_document(character, skeleton, weights, options, out)?,
-    };
-    write_atomically(out, Some(&character.path), &bytes)
+        _ => new_document(character, skeleton, weights, options, out),
+    }
 }
 
 /// Skin weights packed into glTF's fixed-width JOINTS_n/WEIGHTS_n sets.
