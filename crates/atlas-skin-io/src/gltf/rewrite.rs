@@ -159,9 +159,12 @@ fn embed_images(
             renumber_image_sources(texture, &new_index);
         }
     }
-    builder
-        .json_mut()
-        .insert("images".into(), Value::Array(kept));
+    // glTF does not allow an empty top-level array.
+    if !kept.is_empty() {
+        builder
+            .json_mut()
+            .insert("images".into(), Value::Array(kept));
+    }
     Ok(())
 }
 
