@@ -255,6 +255,40 @@ fn cases() -> Vec<Case> {
             outputs: vec!["out.glb"],
             expect: Expect::Error("budget"),
         },
+        Case {
+            name: "position-without-bounds",
+            files: simpleskin_case(|j| {
+                let position = j["accessors"][1].as_object_mut().unwrap();
+                position.remove("min");
+                position.remove("max");
+            }),
+            args: SKIN,
+            outputs: vec!["out.glb"],
+            expect: Expect::Success,
+        },
+        Case {
+            name: "projective-inverse-bind-matrix",
+            files: simpleskin_case(|j| {
+                use base64::Engine;
+                let engine = base64::engine::general_purpose::STANDARD;
+                // Buffer 2 holds the inverse bind matrices: joint 0's last row gets x = 0.5.
+                let uri = j["buffers"][2]["uri"].as_str().unwrap().to_string();
+                let (header, data) = uri.split_once(',').unwrap();
+                let mut bytes = engine.decode(data).unwrap();
+                bytes[12..16].copy_from_slice(&0.5f32.to_le_bytes());
+                j["buffers"][2]["uri"] = json!(format!("{header},{}", engine.encode(bytes)));
+            }),
+            args: SKIN,
+            outputs: vec!["out.glb"],
+            expect: Expect::Success,
+        },
+        Case {
+            name: "joint-with-the-skinned-mesh",
+            files: simpleskin_case(|j| j["nodes"][1]["mesh"] = json!(0)),
+            args: SKIN,
+            outputs: vec!["out.glb"],
+            expect: Expect::Error("is a joint of the skin and also instantiates"),
+        },
         bad_image("image-dotdot", "../secret.bin"),
         bad_image("image-absolute", "/etc/passwd"),
         bad_image("image-dev-urandom", "../../../../../../../../dev/urandom"),

@@ -37,6 +37,8 @@ use std::ops::Range;
 /// - `images`: the bytes of every image given by `uri`, in `document.images` order; `None`
 ///   for images in a bufferView and for those the reader left out (with a warning).
 /// - `skin`: the skin whose joints are the character's skeleton, if any.
+/// - `inverse_binds_cleaned`: the skin's inverse bind matrices were projective and the
+///   skeleton holds affine ones (the writer then writes the skeleton's).
 /// - `primitives`: every primitive read into `Character::mesh`, in mesh order.
 #[derive(Clone)]
 pub struct GltfSource {
@@ -44,6 +46,7 @@ pub struct GltfSource {
     pub buffers: Vec<Vec<u8>>,
     pub images: Vec<Option<ImageBytes>>,
     pub skin: Option<usize>,
+    pub inverse_binds_cleaned: bool,
     pub primitives: Vec<PrimitiveSource>,
 }
 

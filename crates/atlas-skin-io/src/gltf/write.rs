@@ -7,7 +7,7 @@ use super::new_document::new_document;
 use super::rewrite::rewrite_document;
 use crate::output::OutputPlan;
 use crate::{Character, IoError};
-use atlas_skin_runtime::{Clip, VertexWeights};
+use atlas_skin_runtime::{Clip, Skeleton, VertexWeights};
 use serde_json::{Map, Value};
 use std::path::Path;
 
@@ -187,6 +187,16 @@ fn stored_weights(mut row: Vec<(u32, f32)>) -> Vec<(u32, f32)> {
             None => return stored,
         }
     }
+}
+
+/// Appends the inverse bind matrices of `skeleton` as a MAT4 accessor; returns its index.
+pub(crate) fn push_inverse_binds(builder: &mut GlbBuilder, skeleton: &Skeleton) -> usize {
+    let matrices: Vec<f32> = skeleton
+        .inverse_bind
+        .iter()
+        .flat_map(|m| m.to_cols_array())
+        .collect();
+    builder.push_f32_accessor(&matrices, "MAT4", false, None)
 }
 
 /// Appends packed weights as JOINTS/WEIGHTS accessors (joints as UNSIGNED_BYTE below 256
