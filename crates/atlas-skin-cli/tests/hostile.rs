@@ -289,6 +289,28 @@ fn cases() -> Vec<Case> {
             outputs: vec!["out.glb"],
             expect: Expect::Error("is a joint of the skin and also instantiates"),
         },
+        Case {
+            name: "inspect-200k-node-chain",
+            files: simpleskin_case(|j| {
+                // Node 0 holds the skinned mesh; nodes 1..=N form one chain of joints.
+                let count = 200_000;
+                let mut nodes = vec![json!({"mesh": 0, "skin": 0})];
+                nodes.extend((1..=count).map(|n| {
+                    let mut node = json!({"translation": [0.0, 0.001, 0.0]});
+                    if n < count {
+                        node["children"] = json!([n + 1]);
+                    }
+                    node
+                }));
+                j["nodes"] = json!(nodes);
+                j["scenes"] = json!([{"nodes": [0, 1]}]);
+                j["skins"] = json!([{"joints": (1..=count).collect::<Vec<_>>()}]);
+                j.as_object_mut().unwrap().remove("animations");
+            }),
+            args: "inspect {doc}/in.gltf",
+            outputs: vec![],
+            expect: Expect::Success,
+        },
         bad_image("image-dotdot", "../secret.bin"),
         bad_image("image-absolute", "/etc/passwd"),
         bad_image("image-dev-urandom", "../../../../../../../../dev/urandom"),

@@ -162,6 +162,11 @@ fn mesh_instances(
     skin: Option<usize>,
 ) -> Result<Vec<MeshInstance>, IoError> {
     let mesh_count = doc.array("meshes")?.len();
+    let worlds = if skin.is_none() {
+        tree.worlds()
+    } else {
+        Vec::new()
+    };
     let mut instances: Vec<MeshInstance> = Vec::new();
     for (node, object) in doc.array("nodes")?.iter().enumerate() {
         let location = format!("nodes[{node}]");
@@ -187,7 +192,7 @@ fn mesh_instances(
             None => instances.push(MeshInstance {
                 node,
                 mesh,
-                world: Some(tree.world(node)),
+                world: worlds.get(node).copied(),
             }),
         }
     }
