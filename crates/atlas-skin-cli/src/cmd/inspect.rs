@@ -274,7 +274,7 @@ mod tests {
             Skeleton::from_positions(
                 (0..count).map(|j| format!("j{j}")).collect(),
                 (0..count as u32)
-                    .map(|j| j.wrapping_sub(1).min(NO_PARENT))
+                    .map(|j| j.checked_sub(1).unwrap_or(NO_PARENT))
                     .collect(),
                 &vec![Vec3::ZERO; count],
             )
