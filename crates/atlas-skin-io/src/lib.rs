@@ -11,6 +11,7 @@ pub mod bvh;
 pub mod character;
 pub mod dmat;
 pub mod error;
+pub mod fuzz_input;
 pub mod gltf;
 pub mod load;
 pub mod medit;
