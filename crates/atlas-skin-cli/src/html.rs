@@ -11,6 +11,7 @@
 //! `warnings` (strings), `counts` and any other top-level scalar.
 
 use anyhow::{bail, Context};
+use atlas_skin_io::OutputPlan;
 use base64::Engine;
 use std::path::Path;
 
@@ -39,14 +40,14 @@ const GLSL_LINE_FRAG: &str = include_str!("../viewer/line.frag");
 /// Magic of a glTF binary: ASCII "glTF" read as a little-endian u32 (glTF 2.0 §4.4.2).
 const GLB_MAGIC: u32 = 0x4654_6c67;
 
-/// Writes `out`: an HTML page showing `glb_bytes` (a glTF 2.0 binary, skinned or not) with
-/// the optional skinning report (the JSON of `atlas-skin skin --report`; every key is
-/// optional) in its side panel. Writes a temporary file beside `out`, then renames it, so a
-/// failed write leaves no partial report.
+/// Writes `out` through `plan`: an HTML page showing `glb_bytes` (a glTF 2.0 binary,
+/// skinned or not) with the optional skinning report (the JSON of `atlas-skin skin
+/// --report`; every key is optional) in its side panel. `out` also gives the page's title.
 pub fn write_html(
     glb_bytes: &[u8],
     report_json: Option<&serde_json::Value>,
     out: &Path,
+    plan: &OutputPlan,
 ) -> anyhow::Result<()> {
     check_glb_header(glb_bytes)?;
     let title = out
@@ -72,7 +73,7 @@ pub fn write_html(
             ("VIEWER_JS", &viewer_script()),
         ],
     )?;
-    Ok(atlas_skin_io::write_atomically(out, None, page.as_bytes())?)
+    Ok(plan.write(out, page.as_bytes())?)
 }
 
 /// The viewer's scripts joined in order, without their whole-line `//` comments: the sources'
@@ -219,7 +220,8 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("atlas-skin-html-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let out = dir.join("tiny.html");
-        write_html(&tiny_glb(), None, &out).unwrap();
+        let plan = OutputPlan::new([], [out.as_path()]).unwrap();
+        write_html(&tiny_glb(), None, &out, &plan).unwrap();
         let page = std::fs::read_to_string(&out).unwrap();
         std::fs::remove_dir_all(&dir).unwrap();
         assert!(!page.contains("@@"), "a marker was left in the page");

@@ -4,7 +4,7 @@ use anyhow::{Context, Result};
 use atlas_skin::pipeline::{skin, SkinInput, SkinParams, WeldedSurface};
 use atlas_skin::{MeshStats, Topology, Welded};
 use atlas_skin_io::{Character, LoadOptions, TriangleMesh};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// How to read a character's files, besides its main file.
 #[derive(clap::Args, Debug, Clone, Default)]
@@ -22,6 +22,13 @@ pub struct ReadArgs {
 }
 
 impl ReadArgs {
+    /// The files these options name (skeleton, weights).
+    pub fn paths(&self) -> impl Iterator<Item = &Path> {
+        [&self.skeleton, &self.weights]
+            .into_iter()
+            .filter_map(|p| p.as_deref())
+    }
+
     pub fn load_options(&self) -> LoadOptions {
         LoadOptions {
             skeleton: self.skeleton.clone(),
@@ -42,6 +49,11 @@ pub struct InputArgs {
 }
 
 impl InputArgs {
+    /// Every file read: the input and the files of [`ReadArgs`].
+    pub fn paths(&self) -> impl Iterator<Item = &Path> {
+        self.input.as_deref().into_iter().chain(self.read.paths())
+    }
+
     /// Reads the character, or builds the demo character when no input is given.
     pub fn load(&self) -> Result<Character> {
         match &self.input {

@@ -1,6 +1,7 @@
 //! `atlas-skin`: automatic character skinning from the command line.
 
 mod cmd;
+mod counts;
 mod html;
 mod input;
 mod skinning_data;

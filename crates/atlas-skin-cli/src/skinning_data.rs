@@ -11,6 +11,7 @@
 //! ```
 
 use anyhow::{ensure, Context, Result};
+use atlas_skin_io::OutputPlan;
 use atlas_skin_runtime::CompactSkin;
 use glam::{Mat4, Vec3};
 use std::path::Path;
@@ -80,17 +81,17 @@ pub fn encode(
     Ok(bytes)
 }
 
-/// Writes [`encode`]'s bytes to `out` atomically, never over `input`.
+/// Writes [`encode`]'s bytes to the output `out` of `plan`.
 pub fn write(
+    plan: &OutputPlan,
     out: &Path,
-    input: Option<&Path>,
     skin: &CompactSkin,
     positions: &[Vec3],
     normals: &[Vec3],
     palette: &[Mat4],
 ) -> Result<()> {
     let bytes = encode(skin, positions, normals, palette)?;
-    atlas_skin_io::write_atomically(out, input, &bytes)
+    plan.write(out, &bytes)
         .with_context(|| format!("cannot write the skinning data {}", out.display()))
 }
 

@@ -112,7 +112,9 @@ fn the_report_never_replaces_its_input() {
     std::fs::copy(cesiumman(), &input).unwrap();
     let output = report(&[&input, Path::new("-o"), &dir.join("./model.glb")]);
     assert!(!output.status.success());
-    assert!(String::from_utf8_lossy(&output.stderr).contains("is the input file"));
+    assert!(
+        String::from_utf8_lossy(&output.stderr).contains("refusing to write over the input file")
+    );
     assert_eq!(
         std::fs::read(&input).unwrap(),
         std::fs::read(cesiumman()).unwrap()

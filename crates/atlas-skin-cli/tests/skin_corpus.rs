@@ -197,7 +197,8 @@ fn options_reach_the_method_and_bad_ones_are_refused() {
         ("--overlap-joint", "no_such_joint=0.5", "unknown joint"),
         ("--overlap", "0", "not a positive number"),
         ("--overlap-joint", "node13", "expected NAME=F"),
-        ("--max-influences", "0", "at least 1"),
+        ("--max-influences", "0", "outside 1..=32"),
+        ("--max-influences", "4294967296", "outside 1..=32"),
         ("--forbid", "no_such_joint", "is not in the skeleton"),
         ("--force", "no_such_joint", "is not in the skeleton"),
     ] {

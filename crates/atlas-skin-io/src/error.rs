@@ -20,6 +20,8 @@ pub enum IoError {
     },
     #[error("{}: is a directory, not a file", path.display())]
     IsDirectory { path: PathBuf },
+    #[error("{}: not a regular file (a device, FIFO or socket)", path.display())]
+    NotARegularFile { path: PathBuf },
     #[error("{}: the file is empty", path.display())]
     Empty { path: PathBuf },
     #[error("{}: unsupported file type {extension:?} (expected {expected})", path.display())]
@@ -40,8 +42,10 @@ pub enum IoError {
     Invalid { path: PathBuf, message: String },
     #[error("{}: invalid skeleton: {cause}", path.display())]
     Skeleton { path: PathBuf, cause: RuntimeError },
-    #[error("{}: refusing to write over the input file", path.display())]
-    WouldOverwriteInput { path: PathBuf },
+    #[error("{}: refusing to write over the input file {}", path.display(), input.display())]
+    WouldOverwriteInput { path: PathBuf, input: PathBuf },
+    #[error("{}: the same file as the output {}: one command cannot write it twice", path.display(), other.display())]
+    DuplicateOutput { path: PathBuf, other: PathBuf },
 }
 
 impl IoError {

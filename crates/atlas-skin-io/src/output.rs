@@ -1,72 +1,252 @@
-//! Writing an output file safely: never over the input, never half-written.
+//! Writing output files safely: one policy for every command (README, "Security").
+//!
+//! - No output may be an input of the same command, nor another of its outputs (paths
+//!   compared after resolving links, `..` and `.`).
+//! - An existing file at an output path must be a regular file: a folder, device node,
+//!   FIFO or socket is refused, never replaced.
+//! - Bytes go to a temporary file created exclusively (`O_EXCL`) under a random name in the
+//!   output's folder, then renamed over the output: the output is complete or untouched,
+//!   and a link planted at the temporary name cannot redirect the write.
 
 use crate::IoError;
-use std::path::Path;
+use std::collections::hash_map::RandomState;
+use std::hash::{BuildHasher, Hasher};
+use std::io::Write;
+use std::path::{Component, Path, PathBuf};
 
-/// Writes `bytes` to `out` through a temporary file in the same folder that is then renamed
-/// into place, so `out` is either complete or untouched; the temporary file is removed on
-/// error. A missing output folder is created.
-///
-/// # Errors
-/// [`IoError::WouldOverwriteInput`] when `out` is one of the files `inputs` (same path after
-/// resolving links), [`IoError::IsDirectory`] when `out` is a folder, [`IoError::Write`]
-/// when the file cannot be written.
-pub fn write_atomically<'a>(
-    out: &Path,
-    inputs: impl IntoIterator<Item = &'a Path>,
-    bytes: &[u8],
-) -> Result<(), IoError> {
-    check_not_input(out, inputs)?;
-    if out.is_dir() {
-        return Err(IoError::IsDirectory {
-            path: out.to_path_buf(),
-        });
+/// The inputs and outputs of one command, checked together before anything is computed;
+/// the only way this project writes a file.
+#[derive(Debug)]
+pub struct OutputPlan {
+    inputs: Vec<(PathBuf, PathBuf)>,
+    outputs: Vec<(PathBuf, PathBuf)>,
+}
+
+impl OutputPlan {
+    /// Checks the `outputs` a command will write against its `inputs` and each other.
+    ///
+    /// # Errors
+    /// [`IoError::WouldOverwriteInput`] when an output is an input,
+    /// [`IoError::DuplicateOutput`] when two outputs are one file, [`IoError::IsDirectory`]
+    /// or [`IoError::NotARegularFile`] when an output path holds a folder, device, FIFO
+    /// or socket.
+    pub fn new<'a>(
+        inputs: impl IntoIterator<Item = &'a Path>,
+        outputs: impl IntoIterator<Item = &'a Path>,
+    ) -> Result<Self, IoError> {
+        let inputs: Vec<(PathBuf, PathBuf)> = inputs
+            .into_iter()
+            .map(|p| (p.to_path_buf(), resolve(p)))
+            .collect();
+        let mut planned: Vec<(PathBuf, PathBuf)> = Vec::new();
+        for out in outputs {
+            let resolved = resolve(out);
+            if let Some((input, _)) = inputs.iter().find(|(_, r)| *r == resolved) {
+                return Err(IoError::WouldOverwriteInput {
+                    path: out.to_path_buf(),
+                    input: input.clone(),
+                });
+            }
+            if let Some((other, _)) = planned.iter().find(|(_, r)| *r == resolved) {
+                return Err(IoError::DuplicateOutput {
+                    path: out.to_path_buf(),
+                    other: other.clone(),
+                });
+            }
+            check_target(out)?;
+            planned.push((out.to_path_buf(), resolved));
+        }
+        Ok(Self {
+            inputs,
+            outputs: planned,
+        })
     }
-    let write_error = |cause| IoError::Write {
-        path: out.to_path_buf(),
-        cause,
+
+    /// Writes `bytes` to the planned output `out` (see the module documentation). A missing
+    /// output folder is created. On error no file is left at `out` nor beside it.
+    ///
+    /// # Errors
+    /// Those of [`OutputPlan::new`], checked again; [`IoError::Write`] when `out` was not
+    /// planned or the file cannot be written.
+    pub fn write(&self, out: &Path, bytes: &[u8]) -> Result<(), IoError> {
+        let write_error = |cause| IoError::Write {
+            path: out.to_path_buf(),
+            cause,
+        };
+        let resolved = resolve(out);
+        if !self.outputs.iter().any(|(_, r)| *r == resolved) {
+            return Err(write_error(std::io::Error::other(
+                "not one of the command's planned outputs",
+            )));
+        }
+        if let Some((input, _)) = self.inputs.iter().find(|(_, r)| *r == resolved) {
+            return Err(IoError::WouldOverwriteInput {
+                path: out.to_path_buf(),
+                input: input.clone(),
+            });
+        }
+        check_target(out)?;
+        write_atomically(out, bytes).map_err(write_error)
+    }
+}
+
+/// Refuses an existing folder, device, FIFO or socket at `out` (links followed).
+fn check_target(out: &Path) -> Result<(), IoError> {
+    match std::fs::metadata(out) {
+        Ok(metadata) if metadata.is_dir() => Err(IoError::IsDirectory {
+            path: out.to_path_buf(),
+        }),
+        Ok(metadata) if !metadata.is_file() => Err(IoError::NotARegularFile {
+            path: out.to_path_buf(),
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// `path` with links, `.` and `..` resolved as far as it exists: the longest existing
+/// ancestor canonicalized, the rest appended with `.` and `..` applied by name.
+fn resolve(path: &Path) -> PathBuf {
+    let absolute = if path.is_absolute() {
+        path.to_path_buf()
+    } else {
+        std::env::current_dir().unwrap_or_default().join(path)
     };
+    let mut existing = absolute.as_path();
+    let mut rest: Vec<Component> = Vec::new();
+    loop {
+        if let Ok(resolved) = existing.canonicalize() {
+            let mut out = resolved;
+            for component in rest.iter().rev() {
+                match component {
+                    Component::ParentDir => {
+                        out.pop();
+                    }
+                    Component::CurDir => {}
+                    other => out.push(other),
+                }
+            }
+            return out;
+        }
+        match (existing.parent(), existing.components().next_back()) {
+            (Some(parent), Some(last)) => {
+                rest.push(last);
+                existing = parent;
+            }
+            _ => return absolute,
+        }
+    }
+}
+
+/// How many random names are tried before giving up (another file at each).
+const TEMPORARY_NAME_ATTEMPTS: usize = 16;
+
+/// Writes `bytes` to a new temporary file beside `out` (created exclusively, random name)
+/// and renames it to `out`; the temporary file is removed on error.
+fn write_atomically(out: &Path, bytes: &[u8]) -> std::io::Result<()> {
     let name = out
         .file_name()
-        .ok_or_else(|| write_error(std::io::Error::other("the path has no file name")))?;
+        .ok_or_else(|| std::io::Error::other("the path has no file name"))?;
     if let Some(folder) = out.parent().filter(|f| !f.as_os_str().is_empty()) {
-        std::fs::create_dir_all(folder).map_err(write_error)?;
+        std::fs::create_dir_all(folder)?;
     }
-    let temporary = out.with_file_name(format!(
-        ".{}.{}.tmp",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
-    let result = std::fs::write(&temporary, bytes).and_then(|()| std::fs::rename(&temporary, out));
-    if let Err(source) = result {
-        // Best effort: the temporary file may not exist if its creation failed.
+    let mut attempt = 0;
+    let (temporary, mut file) = loop {
+        let temporary = out.with_file_name(format!(
+            ".{}.{:016x}.tmp",
+            name.to_string_lossy(),
+            random_u64()
+        ));
+        match std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&temporary)
+        {
+            Ok(file) => break (temporary, file),
+            Err(e)
+                if e.kind() == std::io::ErrorKind::AlreadyExists
+                    && attempt + 1 < TEMPORARY_NAME_ATTEMPTS =>
+            {
+                attempt += 1;
+            }
+            Err(e) => return Err(e),
+        }
+    };
+    let result = file
+        .write_all(bytes)
+        .and_then(|()| file.sync_all())
+        .and_then(|()| std::fs::rename(&temporary, out));
+    if result.is_err() {
+        // Best effort: the error being reported matters more than a failed cleanup.
         let _ = std::fs::remove_file(&temporary);
-        return Err(write_error(source));
     }
-    Ok(())
+    result
 }
 
-/// [`IoError::WouldOverwriteInput`] when `out` is one of the files `inputs`: lets a
-/// command refuse an output before it writes any other.
-pub fn check_not_input<'a>(
-    out: &Path,
-    inputs: impl IntoIterator<Item = &'a Path>,
-) -> Result<(), IoError> {
-    if inputs.into_iter().any(|input| is_same_file(out, input)) {
-        return Err(IoError::WouldOverwriteInput {
-            path: out.to_path_buf(),
-        });
-    }
-    Ok(())
+/// A random number from the standard library's randomly seeded hasher (no dependency).
+fn random_u64() -> u64 {
+    let mut hasher = RandomState::new().build_hasher();
+    hasher.write_u128(
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos()),
+    );
+    hasher.write_u32(std::process::id());
+    hasher.finish()
 }
 
-/// True when `a` and `b` name the same file (equal paths, or equal once resolved).
-fn is_same_file(a: &Path, b: &Path) -> bool {
-    if a == b {
-        return true;
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch(test: &str) -> PathBuf {
+        let dir = std::env::temp_dir()
+            .join(format!("atlas-skin-output-{}", std::process::id()))
+            .join(test);
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
     }
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => false,
+
+    #[test]
+    fn outputs_that_are_inputs_or_each_other_are_refused() {
+        let dir = scratch("plan");
+        let input = dir.join("in.glb");
+        std::fs::write(&input, b"input").unwrap();
+        std::os::unix::fs::symlink(&input, dir.join("link.glb")).unwrap();
+        let dotted = dir.join("sub/../in.glb");
+        for out in [input.clone(), dir.join("link.glb"), dotted] {
+            let error = OutputPlan::new([input.as_path()], [out.as_path()]).unwrap_err();
+            assert!(
+                matches!(error, IoError::WouldOverwriteInput { .. }),
+                "{error}"
+            );
+        }
+        let a = dir.join("a.glb");
+        let also_a = dir.join("new/../a.glb");
+        let error = OutputPlan::new([], [a.as_path(), also_a.as_path()]).unwrap_err();
+        assert!(matches!(error, IoError::DuplicateOutput { .. }), "{error}");
+        let error = OutputPlan::new([], [dir.as_path()]).unwrap_err();
+        assert!(matches!(error, IoError::IsDirectory { .. }), "{error}");
+        let error = OutputPlan::new([], [Path::new("/dev/null")]).unwrap_err();
+        assert!(matches!(error, IoError::NotARegularFile { .. }), "{error}");
+        assert_eq!(std::fs::read(&input).unwrap(), b"input");
+    }
+
+    #[test]
+    fn writes_replace_the_output_and_leave_nothing_else() {
+        let dir = scratch("write");
+        let out = dir.join("deeper/out.bin");
+        let plan = OutputPlan::new([], [out.as_path()]).unwrap();
+        plan.write(&out, b"first").unwrap();
+        plan.write(&out, b"second").unwrap();
+        assert_eq!(std::fs::read(&out).unwrap(), b"second");
+        let names: Vec<_> = std::fs::read_dir(dir.join("deeper"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(names, ["out.bin"]);
+        let other = dir.join("other.bin");
+        assert!(plan.write(&other, b"x").is_err(), "an unplanned output");
+        assert!(!other.exists());
     }
 }

@@ -7,7 +7,8 @@ use serde::de::DeserializeOwned;
 use std::path::Path;
 use std::str::FromStr;
 
-/// Errors for a path that is missing, unreadable, a directory or an empty file.
+/// Errors for a path that is missing, unreadable, a directory, not a regular file (a
+/// device, a FIFO: reading those could block or never end) or an empty file.
 pub(crate) fn check_file(path: &Path) -> Result<(), IoError> {
     let metadata = std::fs::metadata(path).map_err(|cause| IoError::Read {
         path: path.to_path_buf(),
@@ -15,6 +16,11 @@ pub(crate) fn check_file(path: &Path) -> Result<(), IoError> {
     })?;
     if metadata.is_dir() {
         return Err(IoError::IsDirectory {
+            path: path.to_path_buf(),
+        });
+    }
+    if !metadata.is_file() {
+        return Err(IoError::NotARegularFile {
             path: path.to_path_buf(),
         });
     }

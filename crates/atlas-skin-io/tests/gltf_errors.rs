@@ -5,7 +5,7 @@ mod gltf_support;
 
 use atlas_skin_io::gltf::{self, WriteOptions};
 use atlas_skin_io::IoError;
-use gltf_support::{model_path, out_dir};
+use gltf_support::{model_path, out_dir, simpleskin};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 
@@ -30,20 +30,6 @@ fn kind_matches(error: &IoError, kind: Kind) -> bool {
 
 fn riggedsimple_glb() -> Vec<u8> {
     std::fs::read(model_path("riggedsimple", "RiggedSimple.glb")).unwrap()
-}
-
-/// SimpleSkin.gltf's JSON with its (embedded) buffer 0 decoded.
-fn simpleskin() -> (Value, Vec<u8>) {
-    use base64::Engine;
-    let json: Value = serde_json::from_slice(
-        &std::fs::read(model_path("simpleskin", "SimpleSkin.gltf")).unwrap(),
-    )
-    .unwrap();
-    let uri = json["buffers"][0]["uri"].as_str().unwrap();
-    let buffer0 = base64::engine::general_purpose::STANDARD
-        .decode(uri.split_once(',').unwrap().1)
-        .unwrap();
-    (json, buffer0)
 }
 
 /// SimpleSkin with buffer 0 replaced by `buffer0`.
@@ -186,6 +172,26 @@ fn broken_files() -> Vec<(&'static str, Vec<u8>, Kind, &'static str)> {
             edited(&|j| j["buffers"][0]["byteLength"] = json!(1000)),
             Kind::Invalid,
             "less than its byteLength",
+        ),
+        (
+            // 100 channels each reading 1M zero key times and translations (16 MB): 1.6 GB
+            // from a tiny file.
+            "budget.gltf",
+            edited(&|j| {
+                let accessors = j["accessors"].as_array_mut().unwrap();
+                let times = accessors.len();
+                accessors.push(json!({"componentType": 5126, "count": 1 << 20, "type": "SCALAR"}));
+                accessors.push(json!({"componentType": 5126, "count": 1 << 20, "type": "VEC3"}));
+                let channels: Vec<Value> = (0..100)
+                    .map(|_| json!({"sampler": 0, "target": {"node": 0, "path": "translation"}}))
+                    .collect();
+                j["animations"] = json!([{
+                    "samplers": [{"input": times, "output": times + 1}],
+                    "channels": channels
+                }]);
+            }),
+            Kind::Invalid,
+            "budget",
         ),
         (
             "cycle.gltf",

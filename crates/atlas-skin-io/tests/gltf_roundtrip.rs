@@ -3,7 +3,8 @@
 
 mod gltf_support;
 
-use atlas_skin_io::gltf::{self, write_debug_glb, write_skinned_glb, WriteOptions};
+use atlas_skin_io::gltf::{self, debug_glb, write_skinned_glb, WriteOptions};
+use atlas_skin_io::OutputPlan;
 use atlas_skin_io::{Character, IoError};
 use atlas_skin_runtime::{Clip, Interpolation, Property, Track, VertexWeights};
 use glam::Vec3;
@@ -347,7 +348,9 @@ fn debug_glb_is_valid() {
     ];
     let lines = [[Vec3::ZERO, Vec3::ONE], [Vec3::X, Vec3::Y]];
     let out = dir.join("debug.glb");
-    write_debug_glb(
+    let lines_only = dir.join("lines.glb");
+    let plan = OutputPlan::new([], [out.as_path(), lines_only.as_path()]).unwrap();
+    let full = debug_glb(
         &positions,
         &triangles,
         &colors,
@@ -356,11 +359,12 @@ fn debug_glb_is_valid() {
         &out,
     )
     .unwrap();
-    let lines_only = dir.join("lines.glb");
-    write_debug_glb(&[], &[], &[], &lines, [0.0, 0.0, 0.0, 1.0], &lines_only).unwrap();
+    plan.write(&out, &full).unwrap();
+    let bytes = debug_glb(&[], &[], &[], &lines, [0.0, 0.0, 0.0, 1.0], &lines_only).unwrap();
+    plan.write(&lines_only, &bytes).unwrap();
     let bad = dir.join("bad.glb");
-    assert!(write_debug_glb(&positions, &[[0, 1, 4]], &[], &[], [1.0; 4], &bad).is_err());
-    assert!(!bad.exists());
+    let error = debug_glb(&positions, &[[0, 1, 4]], &[], &[], [1.0; 4], &bad).unwrap_err();
+    assert!(error.to_string().contains("bad.glb"), "{error}");
     assert_valid(&[out, lines_only]);
 }
 

@@ -9,6 +9,7 @@ pub mod animation;
 pub mod compact_skin;
 pub mod dual_quaternion;
 pub mod error;
+pub mod forest;
 pub mod instruction_set;
 pub mod pose;
 pub mod random_pose;

@@ -114,28 +114,11 @@ impl Skeleton {
                 });
             }
         }
-        for joint in 0..count {
-            // Walk up at most `count` steps: a longer walk must revisit a joint.
-            let mut current = joint;
-            for _ in 0..=count {
-                let parent = self.parents[current];
-                if parent == NO_PARENT {
-                    break;
-                }
-                current = parent as usize;
-                if current == joint {
-                    return Err(RuntimeError::Cycle {
-                        joint,
-                        name: self.names[joint].clone(),
-                    });
-                }
-            }
-            if self.parents[current] != NO_PARENT {
-                return Err(RuntimeError::Cycle {
-                    joint,
-                    name: self.names[joint].clone(),
-                });
-            }
+        if let Some(joint) = crate::forest::find_cycle(count, |j| self.parent(j)) {
+            return Err(RuntimeError::Cycle {
+                joint,
+                name: self.names[joint].clone(),
+            });
         }
         for (joint, m) in self.inverse_bind.iter().enumerate() {
             let det = m.determinant();

@@ -9,8 +9,8 @@
 use super::pose::{write_mesh, BvhMotion, Posable};
 use crate::input::InputArgs;
 use anyhow::{Context, Result};
-use atlas_skin_io::gltf::{write_skinned_glb, WriteOptions};
-use atlas_skin_io::Character;
+use atlas_skin_io::gltf::{skinned_glb, WriteOptions};
+use atlas_skin_io::{Character, OutputPlan};
 use atlas_skin_runtime::{Clip, Interpolation, Property, SkinningMethod, Track, Trs};
 use std::path::{Path, PathBuf};
 
@@ -37,24 +37,45 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let character = args.input.load_skinned()?;
-    let motion = BvhMotion::read(&args.bvh, args.joint_map.as_deref())?;
+    let inputs = || {
+        args.input
+            .paths()
+            .chain([args.bvh.as_path()])
+            .chain(args.joint_map.as_deref())
+    };
     let is_obj = args
         .output
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
     if is_obj {
+        // The frame count, hence the outputs, is known once the motion is read.
+        let motion = BvhMotion::read(&args.bvh, args.joint_map.as_deref())?;
+        let frames = obj_sequence_paths(&args.output, motion.frame_times().len());
+        let plan = OutputPlan::new(inputs(), frames.iter().map(PathBuf::as_path))?;
+        let character = args.input.load_skinned()?;
         let method = if args.dqs {
             SkinningMethod::DualQuaternion
         } else {
             SkinningMethod::LinearBlend
         };
-        write_obj_sequence(&character, &motion, method, &args.output)
+        write_obj_sequence(&character, &motion, method, &frames, &plan)
     } else {
+        let plan = OutputPlan::new(inputs(), [args.output.as_path()])?;
+        let character = args.input.load_skinned()?;
+        let motion = BvhMotion::read(&args.bvh, args.joint_map.as_deref())?;
         let (weights, options) = animation_options(&character, &motion)?;
-        write_skinned_glb(&character, weights, &options, &args.output)
+        let glb = skinned_glb(&character, weights, &options, &args.output)?;
+        plan.write(&args.output, &glb)
             .with_context(|| format!("cannot write {}", args.output.display()))
     }
+}
+
+/// The files of an OBJ sequence of `frames` frames written as `out`: OUT_0001.obj, ...
+fn obj_sequence_paths(out: &Path, frames: usize) -> Vec<PathBuf> {
+    let stem = out.with_extension("");
+    (1..=frames)
+        .map(|frame| PathBuf::from(format!("{}_{frame:04}.obj", stem.display())))
+        .collect()
 }
 
 /// The character at `input` with the BVH motion at `bvh` (and the joint map at
@@ -64,7 +85,7 @@ pub fn animate_glb_bytes(input: &Path, bvh: &Path, joint_map: Option<&Path>) -> 
         .with_context(|| format!("cannot load {}", input.display()))?;
     let motion = BvhMotion::read(bvh, joint_map)?;
     let (weights, options) = animation_options(&character, &motion)?;
-    glb_bytes(&character, weights, &options).context("cannot write the animated glb")
+    skinned_glb(&character, weights, &options, input).context("cannot make the animated glb")
 }
 
 /// The skinned glb of any input with weights (a glb as it is; other formats, e.g. FBX,
@@ -84,28 +105,12 @@ pub fn skinned_glb_bytes(input: &Path) -> Result<Vec<u8>> {
             input.display()
         )
     })?;
-    glb_bytes(&character, weights, &WriteOptions::default())
-}
-
-/// The bytes of the glb [`write_skinned_glb`] writes for `character` with `weights`.
-fn glb_bytes(
-    character: &Character,
-    weights: &atlas_skin_runtime::VertexWeights,
-    options: &WriteOptions,
-) -> Result<Vec<u8>> {
-    // The writer writes files; a private temporary file turns it into bytes.
-    let temporary = std::env::temp_dir().join(format!(
-        "atlas-skin-glb-{}-{}.glb",
-        std::process::id(),
-        std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .map_or(0, |d| d.as_nanos())
-    ));
-    write_skinned_glb(character, weights, options, &temporary)?;
-    let bytes = std::fs::read(&temporary).context("cannot read back the written glb");
-    // Best effort: a leftover file in the temporary directory is harmless.
-    let _ = std::fs::remove_file(&temporary);
-    bytes
+    Ok(skinned_glb(
+        &character,
+        weights,
+        &WriteOptions::default(),
+        input,
+    )?)
 }
 
 /// The weights to write and the writer options carrying the retargeted animation.
@@ -194,18 +199,17 @@ fn write_obj_sequence(
     character: &Character,
     motion: &BvhMotion,
     method: SkinningMethod,
-    out: &Path,
+    frames: &[PathBuf],
+    plan: &OutputPlan,
 ) -> Result<()> {
     let posable = Posable::new(character)?;
     let rig = &posable.rig;
     let mut retarget = motion.retarget(rig)?;
-    let stem = out.with_extension("");
     let mut local = rig.rest.clone();
-    for (frame, &time) in motion.frame_times().iter().enumerate() {
+    for (&time, path) in motion.frame_times().iter().zip(frames) {
         retarget.apply(&motion.rig, &motion.sample(time), rig, &mut local);
         let posed = posable.deform(&local, method)?;
-        let path = PathBuf::from(format!("{}_{:04}.obj", stem.display(), frame + 1));
-        write_mesh(&posed, &character.mesh.triangles, &path)?;
+        write_mesh(&posed, &character.mesh.triangles, path, plan)?;
     }
     Ok(())
 }

@@ -21,7 +21,8 @@
 use super::pose::{Posable, POSE_INFLUENCES};
 use crate::input::InputArgs;
 use crate::skinning_data;
-use anyhow::{ensure, Context, Result};
+use anyhow::{Context, Result};
+use atlas_skin_io::OutputPlan;
 use atlas_skin_runtime::random_pose::random_rotations;
 use atlas_skin_runtime::skinning_job::PARALLEL_CHUNK;
 use atlas_skin_runtime::{
@@ -75,18 +76,22 @@ pub struct Args {
     #[command(flatten)]
     pub input: InputArgs,
     /// Worker threads (1 = the sequential path).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1,
+          value_parser = crate::counts::count_between(1, crate::counts::MAX_THREADS))]
     pub threads: usize,
     /// Replicate the mesh to this many vertices (default: the mesh as is).
-    #[arg(long)]
+    #[arg(long,
+          value_parser = crate::counts::count_between(1, crate::counts::MAX_BENCH_VERTICES))]
     pub vertices: Option<usize>,
     /// Timed samples per method.
-    #[arg(long, default_value_t = 200)]
+    #[arg(long, default_value_t = 200,
+          value_parser = crate::counts::count_between(1, crate::counts::MAX_BENCH_FRAMES))]
     pub frames: usize,
     /// Consecutive frames in one timed sample (1: every frame timed on its own; the
     /// side-by-side runner times samples of about 0.15 s, as ozz-animation's program does,
     /// so that both see the machine's load alike).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1,
+          value_parser = crate::counts::count_between(1, crate::counts::MAX_BENCH_BATCH))]
     pub batch: usize,
     /// The skinning loops: portable, avx2 or avx512 (default: the widest this CPU runs).
     #[arg(long, value_name = "NAME")]
@@ -125,9 +130,7 @@ pub struct BenchReport {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    ensure!(args.threads >= 1, "--threads must be at least 1");
-    ensure!(args.frames >= 1, "--frames must be at least 1");
-    ensure!(args.batch >= 1, "--batch must be at least 1");
+    let plan = OutputPlan::new(args.input.paths(), args.write_data.as_deref())?;
     let set = match &args.instruction_set {
         Some(name) => InstructionSet::from_name(name)?,
         None => InstructionSet::best(),
@@ -139,7 +142,6 @@ pub fn run(args: Args) -> Result<()> {
         .as_ref()
         .context("the character has no skin weights")?;
     let count = args.vertices.unwrap_or(posable.rest_positions.len());
-    ensure!(count >= 1, "--vertices must be at least 1");
     let mut streams = Streams::replicate(&posable, weights, count)?;
     let palettes: Vec<Vec<Mat4>> = (0..POSES as u64)
         .map(|seed| {
@@ -152,8 +154,8 @@ pub fn run(args: Args) -> Result<()> {
         .collect();
     if let Some(out) = &args.write_data {
         skinning_data::write(
+            &plan,
             out,
-            args.input.input.as_deref(),
             &streams.skin,
             &streams.rest_positions,
             &streams.rest_normals,

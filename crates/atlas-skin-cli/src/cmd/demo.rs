@@ -3,7 +3,8 @@
 use crate::input::demo_character;
 use anyhow::{Context, Result};
 use atlas_skin::skeleton::bones::nearest_bone_weights;
-use atlas_skin_io::gltf::{write_skinned_glb, WriteOptions};
+use atlas_skin_io::gltf::{skinned_glb, WriteOptions};
+use atlas_skin_io::OutputPlan;
 use std::path::PathBuf;
 
 /// Writes DIR/demo.glb: the built-in demo character (a closed, genus-0 humanoid with hands,
@@ -30,10 +31,10 @@ pub fn run(args: Args) -> Result<()> {
         .map(|p| p.as_dvec3())
         .collect();
     let weights = nearest_bone_weights(&positions, skeleton);
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("cannot create the folder {}", args.out.display()))?;
     let path = args.out.join("demo.glb");
-    write_skinned_glb(&character, &weights, &WriteOptions::default(), &path)?;
+    let plan = OutputPlan::new([], [path.as_path()])?;
+    let glb = skinned_glb(&character, &weights, &WriteOptions::default(), &path)?;
+    plan.write(&path, &glb)?;
     println!(
         "wrote {} ({} vertices, {} triangles, {} joints)",
         path.display(),

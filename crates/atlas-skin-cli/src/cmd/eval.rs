@@ -24,13 +24,15 @@ pub struct Args {
     #[command(flatten)]
     pub read: ReadArgs,
     /// Number of seeded random poses.
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = 10,
+          value_parser = crate::counts::count_between(1, crate::counts::MAX_EVAL_POSES))]
     pub poses: usize,
     /// Seed of the first random pose (pose i uses seed + i).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Number of frames of the reference's first animation (0 skips the animation figures).
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = 8,
+          value_parser = crate::counts::count_between(0, crate::counts::MAX_EVAL_POSES))]
     pub anim_frames: usize,
     /// Keep only the N largest reference weights per vertex before renormalising
     /// (BASELINES.md does so with 4 for MakeHuman).
@@ -38,7 +40,8 @@ pub struct Args {
     pub prune_reference: Option<u16>,
     /// List the N vertices with the largest random-pose (LBS) error, with both weight rows
     /// (JSON key `worst_vertices`).
-    #[arg(long, value_name = "N", default_value_t = 0)]
+    #[arg(long, value_name = "N", default_value_t = 0,
+          value_parser = crate::counts::count_between(0, crate::counts::MAX_WORST_VERTICES))]
     pub worst: usize,
     /// Print the figures as JSON.
     #[arg(long)]

@@ -33,6 +33,9 @@ pub fn run(args: Args) -> Result<()> {
 /// `welded_vertices`, `triangles`, `components`, `closed`, `euler_characteristic`, `genus`
 /// (null when open) and `joints` (name, parent, position, inside) are relied on by tests and
 /// scripts.
+/// Deepest level of the joint tree that `inspect` indents.
+pub const MAX_TREE_INDENT: usize = 16;
+
 #[derive(Debug, Serialize)]
 pub struct Report {
     pub input: String,
@@ -165,7 +168,8 @@ impl Report {
         }
     }
 
-    /// The human-readable report, with the joint tree indented by depth.
+    /// The human-readable report, with the joint tree indented by depth (up to
+    /// [`MAX_TREE_INDENT`] levels).
     pub fn to_text(&self) -> String {
         let yes_no = |b: bool| if b { "yes" } else { "no" };
         let genus = self
@@ -215,9 +219,16 @@ impl Report {
         for (depth, joint) in self.joint_tree() {
             let [x, y, z] = joint.position;
             let flag = if joint.inside { "inside " } else { "OUTSIDE" };
-            let indent = "  ".repeat(depth);
+            // Indentation stops growing at MAX_TREE_INDENT; deeper joints state their depth,
+            // so a 200,000-joint chain prints 200,000 short lines.
+            let indent = "  ".repeat(depth.min(MAX_TREE_INDENT));
+            let deep = if depth > MAX_TREE_INDENT {
+                format!("[depth {depth}] ")
+            } else {
+                String::new()
+            };
             lines.push(format!(
-                "  {flag} {indent}{} ({x:.4}, {y:.4}, {z:.4})",
+                "  {flag} {indent}{deep}{} ({x:.4}, {y:.4}, {z:.4})",
                 joint.name
             ));
         }
@@ -298,6 +309,30 @@ mod tests {
         let json = serde_json::to_value(&report).unwrap();
         assert_eq!(json["joints"][1]["parent"], "hips");
         assert!(json["joints"][1].get("parent_index").is_none());
+    }
+
+    #[test]
+    fn deep_trees_stop_indenting() {
+        let count = 1000;
+        let mesh = TriangleMesh {
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+            triangles: vec![[0, 1, 2]],
+        };
+        let mut character = Character::new("chain.obj", mesh);
+        character.skeleton = Some(
+            Skeleton::from_positions(
+                (0..count).map(|j| format!("j{j}")).collect(),
+                (0..count as u32)
+                    .map(|j| j.checked_sub(1).unwrap_or(NO_PARENT))
+                    .collect(),
+                &vec![Vec3::ZERO; count],
+            )
+            .unwrap(),
+        );
+        let text = Report::new(&Prepared::new(character)).to_text();
+        let longest = text.lines().map(str::len).max().unwrap();
+        assert!(longest < 120, "a line of {longest} characters");
+        assert!(text.contains("[depth 999] j999 ("), "{text}");
     }
 
     #[test]

@@ -8,7 +8,7 @@
 
 use crate::input::InputArgs;
 use anyhow::{anyhow, bail, ensure, Context, Result};
-use atlas_skin_io::Character;
+use atlas_skin_io::{Character, OutputPlan};
 use atlas_skin_runtime::pose::palette_from_world;
 use atlas_skin_runtime::random_pose::random_rotations;
 use atlas_skin_runtime::retarget::Retarget;
@@ -35,7 +35,7 @@ pub struct Args {
     #[command(flatten)]
     pub source: PoseSource,
     /// Seconds into the animation, with --anim.
-    #[arg(long, default_value_t = 0.0, requires = "anim")]
+    #[arg(long, default_value_t = 0.0, requires = "anim", value_parser = crate::counts::finite)]
     pub time: f32,
     /// Frame of the BVH motion (0 = first), with --bvh.
     #[arg(long, default_value_t = 0, requires = "bvh")]
@@ -71,6 +71,11 @@ pub struct PoseSource {
 }
 
 pub fn run(args: Args) -> Result<()> {
+    let source = &args.source;
+    let inputs = [&source.bvh, &source.pose, &args.joint_map]
+        .into_iter()
+        .filter_map(|p| p.as_deref());
+    let plan = OutputPlan::new(args.input.paths().chain(inputs), [args.output.as_path()])?;
     let character = args.input.load_skinned()?;
     let posable = Posable::new(&character)?;
     let local = match (&args.source.anim, &args.source.bvh, &args.source.pose) {
@@ -88,7 +93,7 @@ pub fn run(args: Args) -> Result<()> {
         SkinningMethod::LinearBlend
     };
     let posed = posable.deform(&local, method)?;
-    write_mesh(&posed, &character.mesh.triangles, &args.output)
+    write_mesh(&posed, &character.mesh.triangles, &args.output, &plan)
 }
 
 /// A skinned character ready to pose: its rig, skeleton, compact skin and rest streams.
@@ -422,27 +427,27 @@ pub fn vertex_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
     normals.iter().map(|n| n.normalize_or_zero()).collect()
 }
 
-/// Writes the posed mesh as OBJ (`v`, `vn`, `f a//a b//b c//c`, full float precision) or
-/// as a static glb, by the extension of `out`.
-pub fn write_mesh(posed: &PosedMesh, triangles: &[[u32; 3]], out: &Path) -> Result<()> {
+/// Writes the posed mesh through `plan` as OBJ (`v`, `vn`, `f a//a b//b c//c`, full float
+/// precision) or as a static glb, by the extension of `out`.
+pub fn write_mesh(
+    posed: &PosedMesh,
+    triangles: &[[u32; 3]],
+    out: &Path,
+    plan: &OutputPlan,
+) -> Result<()> {
     let extension = out
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
-    match extension.as_deref() {
-        Some("obj") => std::fs::write(out, obj_text(posed, triangles))
-            .with_context(|| format!("cannot write {}", out.display())),
-        Some("glb") => atlas_skin_io::gltf::write_debug_glb(
-            &posed.positions,
-            triangles,
-            &[],
-            &[],
-            [0.0; 4],
-            out,
-        )
-        .with_context(|| format!("cannot write {}", out.display())),
+    let bytes = match extension.as_deref() {
+        Some("obj") => obj_text(posed, triangles).into_bytes(),
+        Some("glb") => {
+            atlas_skin_io::gltf::debug_glb(&posed.positions, triangles, &[], &[], [0.0; 4], out)?
+        }
         _ => bail!("{}: the output must end in .obj or .glb", out.display()),
-    }
+    };
+    plan.write(out, &bytes)
+        .with_context(|| format!("cannot write {}", out.display()))
 }
 
 fn obj_text(posed: &PosedMesh, triangles: &[[u32; 3]]) -> String {

@@ -1,7 +1,8 @@
 //! `atlas-skin report`: the self-contained HTML report of a skinned glTF binary (see
 //! [`crate::html`]).
 
-use anyhow::{bail, Context};
+use anyhow::Context;
+use atlas_skin_io::OutputPlan;
 use std::path::{Path, PathBuf};
 
 pub use crate::html::write_html;
@@ -29,7 +30,12 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> anyhow::Result<()> {
-    refuse_overwrite(&args.input, &args.output)?;
+    let inputs = [Some(&args.input), args.report.as_ref(), args.bvh.as_ref()]
+        .into_iter()
+        .chain([args.joint_map.as_ref()])
+        .flatten()
+        .map(PathBuf::as_path);
+    let plan = OutputPlan::new(inputs, [args.output.as_path()])?;
     let glb = match &args.bvh {
         Some(bvh) => {
             crate::cmd::animate::animate_glb_bytes(&args.input, bvh, args.joint_map.as_deref())
@@ -38,7 +44,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         None => crate::cmd::animate::skinned_glb_bytes(&args.input)?,
     };
     let report = args.report.as_deref().map(read_report).transpose()?;
-    write_html(&glb, report.as_ref(), &args.output)
+    write_html(&glb, report.as_ref(), &args.output, &plan)
         .with_context(|| format!("writing the report of {}", args.input.display()))
 }
 
@@ -46,14 +52,4 @@ fn read_report(path: &Path) -> anyhow::Result<serde_json::Value> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     serde_json::from_str(&text).with_context(|| format!("{} is not valid JSON", path.display()))
-}
-
-/// The report must not replace its own input.
-fn refuse_overwrite(input: &Path, output: &Path) -> anyhow::Result<()> {
-    if let (Ok(input), Ok(output)) = (input.canonicalize(), output.canonicalize()) {
-        if input == output {
-            bail!("the output {} is the input file", output.display());
-        }
-    }
-    Ok(())
 }

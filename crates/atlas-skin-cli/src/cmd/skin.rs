@@ -2,14 +2,15 @@
 //! joints, regions, geodesic overlaps, blended weights: [`atlas_skin::pipeline::skin`]) and
 //! writes a skinned glTF binary, with an optional JSON report, debug view and HTML report.
 
+use crate::counts::{check_count, MAX_INFLUENCES};
 use crate::input::InputArgs;
-use anyhow::{bail, Context, Result};
+use anyhow::{anyhow, bail, Context, Result};
 use atlas_skin::pipeline::{skin, SkinInput, SkinParams, Skinned, Stage};
 use atlas_skin::report::{debug_colors, debug_lines};
 use atlas_skin::weights::blend::Blend;
 use atlas_skin::BoundaryKind;
-use atlas_skin_io::gltf::{write_debug_glb, write_skinned_glb, WriteOptions};
-use atlas_skin_io::Character;
+use atlas_skin_io::gltf::{debug_glb, skinned_glb, WriteOptions};
+use atlas_skin_io::{Character, OutputPlan};
 use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::{json, Value};
@@ -49,7 +50,8 @@ pub struct Args {
     #[arg(long, value_name = "JOINT")]
     pub forbid: Vec<String>,
     /// Influences kept per vertex (the largest, renormalised).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N",
+          value_parser = crate::counts::count_between(1, crate::counts::MAX_INFLUENCES))]
     pub max_influences: Option<usize>,
     /// Write an unskinned glb with the regions as vertex colours and the cut curves.
     #[arg(long, value_name = "D.glb")]
@@ -62,18 +64,6 @@ pub struct Args {
     /// as the mesh file does (OBJ order).
     #[arg(long, value_name = "OUT.txt")]
     pub rig_info: Option<PathBuf>,
-}
-
-/// The files a command reads: the input and its skeleton and weights files.
-fn input_files(input: &InputArgs) -> impl Iterator<Item = &Path> {
-    [
-        input.input.as_ref(),
-        input.read.skeleton.as_ref(),
-        input.read.weights.as_ref(),
-    ]
-    .into_iter()
-    .flatten()
-    .map(PathBuf::as_path)
 }
 
 /// `--blend` values.
@@ -95,6 +85,17 @@ impl From<BlendArg> for Blend {
 }
 
 pub fn run(args: Args) -> Result<()> {
+    let outputs = [
+        Some(&args.output),
+        args.report.as_ref(),
+        args.debug_glb.as_ref(),
+        args.html.as_ref(),
+        args.rig_info.as_ref(),
+    ]
+    .into_iter()
+    .flatten()
+    .map(PathBuf::as_path);
+    let plan = OutputPlan::new(args.input.paths().chain(args.config.as_deref()), outputs)?;
     let params = params(&args)?;
     let character = args.input.load()?;
     let Some(skeleton) = character.skeleton.clone() else {
@@ -103,9 +104,6 @@ pub fn run(args: Args) -> Result<()> {
             character.path.display()
         );
     };
-    if let Some(path) = &args.rig_info {
-        atlas_skin_io::check_not_input(path, input_files(&args.input))?;
-    }
     let mut timings = serde_json::Map::new();
     let progress = progress_bar();
     let skinned = skin(
@@ -129,7 +127,8 @@ pub fn run(args: Args) -> Result<()> {
         max_influences: params.max_influences,
         ..WriteOptions::default()
     };
-    write_skinned_glb(&character, &skinned.weights, &options, &args.output)?;
+    let glb = skinned_glb(&character, &skinned.weights, &options, &args.output)?;
+    plan.write(&args.output, &glb)?;
     timings.insert("write".into(), json!(start.elapsed().as_secs_f64() * 1e3));
     let rig_info = args.rig_info.as_ref().map(|path| {
         let pruned = skinned.weights.pruned(params.max_influences);
@@ -141,18 +140,16 @@ pub fn run(args: Args) -> Result<()> {
     let report = report(&character, &skinned, timings);
     if let Some(path) = &args.report {
         let text = serde_json::to_string_pretty(&report)?;
-        atlas_skin_io::write_atomically(path, Some(character.path.as_path()), text.as_bytes())?;
+        plan.write(path, text.as_bytes())?;
     }
     if let Some((path, text)) = &rig_info {
-        atlas_skin_io::write_atomically(path, input_files(&args.input), text.as_bytes())?;
+        plan.write(path, text.as_bytes())?;
     }
     if let Some(path) = &args.debug_glb {
-        write_debug(&skinned, path)?;
+        plan.write(path, &debug_view(&skinned, path)?)?;
     }
     if let Some(path) = &args.html {
-        let glb = std::fs::read(&args.output)
-            .with_context(|| format!("cannot read back {}", args.output.display()))?;
-        crate::html::write_html(&glb, Some(&report), path)?;
+        crate::html::write_html(&glb, Some(&report), path, &plan)?;
     }
     let d = skinned.decomposition.report();
     println!(
@@ -197,6 +194,10 @@ fn params(args: &Args) -> Result<SkinParams> {
     }
     if let Some(n) = args.max_influences {
         params.max_influences = n;
+    }
+    if let Some(path) = &args.config {
+        check_count(params.max_influences, 1, MAX_INFLUENCES)
+            .map_err(|e| anyhow!("{}: max_influences {e}", path.display()))?;
     }
     params.decompose.force.extend(args.force.iter().cloned());
     params.decompose.forbid.extend(args.forbid.iter().cloned());
@@ -305,15 +306,15 @@ fn report(
     })
 }
 
-/// The debug view: the split surface coloured by region, the cut curves as lines.
-fn write_debug(skinned: &Skinned, path: &Path) -> Result<()> {
+/// The debug view (a glb): the split surface coloured by region, the cut curves as lines.
+fn debug_view(skinned: &Skinned, path: &Path) -> Result<Vec<u8>> {
     let d = &skinned.decomposition;
     let positions: Vec<Vec3> = d.surface.positions.iter().map(|p| p.as_vec3()).collect();
     let lines: Vec<[Vec3; 2]> = debug_lines(d)
         .iter()
         .map(|[a, b]| [Vec3::from_array(*a), Vec3::from_array(*b)])
         .collect();
-    write_debug_glb(
+    debug_glb(
         &positions,
         &d.surface.triangles,
         &debug_colors(d),

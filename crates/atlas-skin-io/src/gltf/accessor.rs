@@ -144,6 +144,16 @@ impl Accessor<'_> {
         self.components * self.component.size()
     }
 
+    /// Bytes [`Accessor::decode`] allocates: 4 per component (f32 or u32), and 4 per
+    /// sparse index.
+    fn decoded_bytes(&self) -> u64 {
+        let sparse = self.sparse.as_ref().map_or(0, |s| s.indices.len() as u64);
+        (self.count as u64)
+            .saturating_mul(self.components as u64)
+            .saturating_add(sparse)
+            .saturating_mul(4)
+    }
+
     /// All elements' components, flattened, decoded by `decode` from each component's
     /// bytes; missing dense data reads as `zero`.
     fn decode<T: Copy>(&self, zero: T, decode: impl Fn(&[u8]) -> T) -> Vec<T> {
@@ -390,6 +400,7 @@ pub(crate) fn read_floats(
     role: &str,
 ) -> Result<Vec<f32>, IoError> {
     let accessor = accessor(doc, index, expected_type).map_err(|e| used_as(e, role))?;
+    doc.charge(accessor.decoded_bytes(), role)?;
     let (component, normalized) = (accessor.component, accessor.normalized);
     Ok(accessor.decode(0.0, |b| component.decode_f32(b, normalized)))
 }
@@ -404,6 +415,7 @@ pub(crate) fn read_uints(
     role: &str,
 ) -> Result<Vec<u32>, IoError> {
     let accessor = accessor(doc, index, expected_type).map_err(|e| used_as(e, role))?;
+    doc.charge(accessor.decoded_bytes(), role)?;
     let component = accessor.component;
     if !component.is_unsigned_integer() || accessor.normalized {
         return Err(doc.error(format!(
@@ -431,6 +443,7 @@ mod tests {
             json,
             buffers,
             path: Path::new("t.gltf"),
+            budget: &crate::gltf::budget::DecodeBudget::for_input(0),
         });
     }
 

@@ -200,7 +200,7 @@ fn components_of(type_name: &str) -> usize {
 }
 
 /// Per-component minimum and maximum of flattened elements with `components` each.
-fn component_bounds(values: &[f32], components: usize) -> (Vec<f32>, Vec<f32>) {
+pub(crate) fn component_bounds(values: &[f32], components: usize) -> (Vec<f32>, Vec<f32>) {
     let mut min = vec![f32::INFINITY; components];
     let mut max = vec![f32::NEG_INFINITY; components];
     for element in values.chunks_exact(components) {

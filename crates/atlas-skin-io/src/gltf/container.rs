@@ -1,10 +1,11 @@
 //! The glTF containers: a `.glb` binary (12-byte header, JSON chunk, optional BIN chunk), or
-//! a `.gltf` JSON file whose buffers are base64 `data:` URIs or files beside it.
+//! a `.gltf` JSON file whose buffers are base64 `data:` URIs or files beside it (see
+//! [`DocumentFolder`] for which files a document may name).
 
+use super::file_access::DocumentFolder;
 use crate::IoError;
-use base64::Engine;
 use serde_json::Value;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// The first 4 bytes of a GLB file (glTF 2.0 §4.4.2).
 const GLB_MAGIC: &[u8; 4] = b"glTF";
@@ -16,12 +17,16 @@ const CHUNK_BIN: u32 = 0x004E_4942;
 /// without BOM) but some exporters write.
 const UTF8_BOM: &[u8; 3] = b"\xEF\xBB\xBF";
 
-/// A glTF document as read: its JSON, the bytes of every buffer (in `buffers` order) and
-/// warnings about tolerated departures from the format.
+/// A glTF document as read: its JSON, the bytes of every buffer (in `buffers` order), of
+/// every image given by `uri` (in `images` order; `None` for the others and for those left
+/// out), warnings about tolerated departures from the format, and the bytes read in all
+/// (the file, its buffers and images).
 pub(crate) struct Container {
     pub json: Value,
     pub buffers: Vec<Vec<u8>>,
+    pub images: Vec<Option<ImageBytes>>,
     pub warnings: Vec<String>,
+    pub input_bytes: u64,
 }
 
 /// Reads the `.glb`, `.vrm` or `.gltf` file at `path` and every buffer it refers to.
@@ -30,7 +35,7 @@ pub(crate) struct Container {
 /// else must be a `.gltf` JSON file. JSON starting with a UTF-8 byte-order mark is read
 /// with a warning.
 pub(crate) fn read_container(path: &Path) -> Result<Container, IoError> {
-    let bytes = read_file(path)?;
+    let bytes = crate::text::read_bytes(path)?;
     let is_binary_name = matches!(extension(path).as_str(), "glb" | "vrm");
     let (json_bytes, bin) = if bytes.starts_with(GLB_MAGIC) {
         split_glb(path, &bytes)?
@@ -59,31 +64,18 @@ pub(crate) fn read_container(path: &Path) -> Result<Container, IoError> {
         None => json_bytes,
     };
     let json = parse_json(path, json_bytes)?;
-    let buffers = load_buffers(path, &json, bin)?;
+    let mut folder = DocumentFolder::of(path);
+    let buffers = load_buffers(path, &json, bin, &mut folder)?;
+    let buffer_bytes = buffers.iter().map(|b| b.len() as u64).sum();
+    let images = load_images(path, &json, buffer_bytes, &mut folder, &mut warnings)?;
+    let image_bytes: u64 = images.iter().flatten().map(|i| i.bytes.len() as u64).sum();
     Ok(Container {
         json,
         buffers,
+        images,
         warnings,
+        input_bytes: bytes.len() as u64 + buffer_bytes + image_bytes,
     })
-}
-
-/// The file's bytes; a directory or an empty file is an error of its own.
-fn read_file(path: &Path) -> Result<Vec<u8>, IoError> {
-    if path.is_dir() {
-        return Err(IoError::IsDirectory {
-            path: path.to_path_buf(),
-        });
-    }
-    let bytes = std::fs::read(path).map_err(|cause| IoError::Read {
-        path: path.to_path_buf(),
-        cause,
-    })?;
-    if bytes.is_empty() {
-        return Err(IoError::Empty {
-            path: path.to_path_buf(),
-        });
-    }
-    Ok(bytes)
 }
 
 /// Lower-case extension of `path`, empty when it has none.
@@ -189,18 +181,28 @@ fn parse_json(path: &Path, bytes: &[u8]) -> Result<Value, IoError> {
     }
 }
 
+/// Largest total of bytes a document may load besides its own file: its external and
+/// `data:` buffers and its images (docs/formats.md, "Memory").
+pub const MAX_LOADED_BYTES: u64 = 1 << 30;
+
+/// The bufferViews may span at most this many times the buffers' bytes, plus
+/// [`VIEW_SLACK_BYTES`], in total: views may overlap, but every view is copied into a
+/// skinned output, so 600 views over one buffer would multiply it 600 times.
+const MAX_VIEW_OVERLAP: u64 = 2;
+const VIEW_SLACK_BYTES: u64 = 1 << 20;
+
 /// Loads every buffer of the document: the GLB BIN chunk for a buffer without `uri`, a
-/// base64 `data:` URI, or a file relative to the document's folder. Each buffer is cut to
-/// its `byteLength`, and must be at least that long.
-fn load_buffers(path: &Path, json: &Value, bin: Option<Vec<u8>>) -> Result<Vec<Vec<u8>>, IoError> {
-    let empty = Vec::new();
-    let declared = match json.get("buffers") {
-        None => &empty,
-        Some(Value::Array(buffers)) => buffers,
-        Some(_) => return Err(IoError::invalid(path, "\"buffers\" is not an array")),
-    };
-    let mut bin = bin;
-    let mut buffers = Vec::with_capacity(declared.len());
+/// base64 `data:` URI, or a file inside the document's folder ([`DocumentFolder`]). The
+/// declared byteLengths must add up to at most [`MAX_LOADED_BYTES`] before anything is
+/// read; each buffer is cut to its `byteLength`, and must be at least that long.
+fn load_buffers(
+    path: &Path,
+    json: &Value,
+    bin: Option<Vec<u8>>,
+    folder: &mut DocumentFolder,
+) -> Result<Vec<Vec<u8>>, IoError> {
+    let declared = top_level_array(path, json, "buffers")?;
+    let mut lengths = Vec::with_capacity(declared.len());
     for (index, buffer) in declared.iter().enumerate() {
         let byte_length = buffer
             .get("byteLength")
@@ -208,6 +210,20 @@ fn load_buffers(path: &Path, json: &Value, bin: Option<Vec<u8>>) -> Result<Vec<V
             .ok_or_else(|| {
                 IoError::invalid(path, format!("buffers[{index}] has no valid byteLength"))
             })?;
+        lengths.push(byte_length);
+    }
+    let total = lengths.iter().fold(0u64, |sum, &l| sum.saturating_add(l));
+    if total > MAX_LOADED_BYTES {
+        return Err(IoError::invalid(
+            path,
+            format!(
+                "the buffers declare {total} bytes in total, more than the {MAX_LOADED_BYTES}                  a document may load"
+            ),
+        ));
+    }
+    let mut bin = bin;
+    let mut buffers = Vec::with_capacity(declared.len());
+    for (index, (buffer, &byte_length)) in declared.iter().zip(&lengths).enumerate() {
         let mut bytes = match buffer.get("uri") {
             None if index == 0 => bin.take().ok_or_else(|| {
                 IoError::invalid(
@@ -224,9 +240,11 @@ fn load_buffers(path: &Path, json: &Value, bin: Option<Vec<u8>>) -> Result<Vec<V
                 ))
             }
             Some(Value::String(uri)) => {
-                load_uri(path, uri)
-                    .map_err(|e| IoError::invalid(path, format!("buffers[{index}]: {e}")))?
-                    .0
+                let user = format!("buffers[{index}]");
+                folder
+                    .read(uri, &user, byte_length, true)
+                    .map_err(|e| IoError::invalid(path, format!("{user}: {e}")))?
+                    .bytes
             }
             Some(_) => {
                 return Err(IoError::invalid(
@@ -247,60 +265,83 @@ fn load_buffers(path: &Path, json: &Value, bin: Option<Vec<u8>>) -> Result<Vec<V
         bytes.truncate(byte_length as usize);
         buffers.push(bytes);
     }
+    check_view_total(path, json, total)?;
     Ok(buffers)
 }
 
-/// The bytes a URI of the document at `document_path` points to, and the media type a
-/// `data:` URI declares. Relative URIs are percent-decoded and resolved against the
-/// document's folder.
-pub(crate) fn load_uri(
-    document_path: &Path,
-    uri: &str,
-) -> Result<(Vec<u8>, Option<String>), String> {
-    if let Some(data) = uri.strip_prefix("data:") {
-        let (header, payload) = data.split_once(',').ok_or("a data: URI without a comma")?;
-        let media_type = header.strip_suffix(";base64").ok_or_else(|| {
-            format!("data: URI with header {header:?} is not base64 (only base64 is supported)")
-        })?;
-        let bytes = base64::engine::general_purpose::STANDARD
-            .decode(payload.trim())
-            .map_err(|e| format!("bad base64 in data: URI: {e}"))?;
-        let media_type = (!media_type.is_empty()).then(|| media_type.to_string());
-        return Ok((bytes, media_type));
+/// The top-level array `key` of the document; empty when absent.
+fn top_level_array<'a>(path: &Path, json: &'a Value, key: &str) -> Result<&'a [Value], IoError> {
+    match json.get(key) {
+        None => Ok(&[]),
+        Some(Value::Array(items)) => Ok(items),
+        Some(_) => Err(IoError::invalid(path, format!("\"{key}\" is not an array"))),
     }
-    if uri.contains("://") {
-        return Err(format!("external URI {uri:?} is not a local file"));
-    }
-    let relative = percent_decode(uri)?;
-    let file: PathBuf = document_path
-        .parent()
-        .unwrap_or(Path::new(""))
-        .join(relative);
-    std::fs::read(&file)
-        .map(|bytes| (bytes, None))
-        .map_err(|e| format!("cannot read {}: {e}", file.display()))
 }
 
-/// Decodes `%XX` escapes of a URI path (RFC 3986 §2.1).
-fn percent_decode(uri: &str) -> Result<String, String> {
-    let bytes = uri.as_bytes();
-    let mut out = Vec::with_capacity(bytes.len());
-    let mut i = 0;
-    while i < bytes.len() {
-        if bytes[i] == b'%' {
-            let hex = bytes
-                .get(i + 1..i + 3)
-                .and_then(|h| std::str::from_utf8(h).ok())
-                .and_then(|h| u8::from_str_radix(h, 16).ok())
-                .ok_or_else(|| format!("bad percent escape in URI {uri:?}"))?;
-            out.push(hex);
-            i += 3;
-        } else {
-            out.push(bytes[i]);
-            i += 1;
+/// The bufferViews may span at most [`MAX_VIEW_OVERLAP`] times the buffers' bytes plus
+/// [`VIEW_SLACK_BYTES`].
+fn check_view_total(path: &Path, json: &Value, buffer_bytes: u64) -> Result<(), IoError> {
+    let views = top_level_array(path, json, "bufferViews")?;
+    let spanned = views
+        .iter()
+        .filter_map(|view| view.get("byteLength").and_then(Value::as_u64))
+        .fold(0u64, u64::saturating_add);
+    let limit = buffer_bytes
+        .saturating_mul(MAX_VIEW_OVERLAP)
+        .saturating_add(VIEW_SLACK_BYTES);
+    if spanned > limit {
+        return Err(IoError::invalid(
+            path,
+            format!(
+                "the bufferViews span {spanned} bytes in total, more than {MAX_VIEW_OVERLAP} \
+                 times the {buffer_bytes} bytes of the buffers plus {VIEW_SLACK_BYTES}"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// An image given by `uri`, as read: its bytes and the media type a `data:` URI declared.
+#[derive(Clone)]
+pub struct ImageBytes {
+    pub bytes: Vec<u8>,
+    pub media_type: Option<String>,
+}
+
+/// Loads every image given by `uri` (`None` for images in a bufferView). An image the
+/// policy of [`DocumentFolder`] refuses, or one past [`MAX_LOADED_BYTES`] with the buffers,
+/// is left out (`None`) with a warning naming it.
+fn load_images(
+    path: &Path,
+    json: &Value,
+    mut loaded: u64,
+    folder: &mut DocumentFolder,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<Option<ImageBytes>>, IoError> {
+    let images = top_level_array(path, json, "images")?;
+    let mut out = Vec::with_capacity(images.len());
+    for (index, image) in images.iter().enumerate() {
+        let Some(uri) = image.get("uri").and_then(Value::as_str) else {
+            out.push(None);
+            continue;
+        };
+        let user = format!("images[{index}]");
+        let remaining = MAX_LOADED_BYTES.saturating_sub(loaded);
+        match folder.read(uri, &user, remaining, false) {
+            Ok(read) => {
+                loaded += read.bytes.len() as u64;
+                out.push(Some(ImageBytes {
+                    bytes: read.bytes,
+                    media_type: read.media_type,
+                }));
+            }
+            Err(e) => {
+                warnings.push(format!("{user} left out: {e}"));
+                out.push(None);
+            }
         }
     }
-    String::from_utf8(out).map_err(|_| format!("URI {uri:?} does not decode to UTF-8"))
+    Ok(out)
 }
 
 /// A GLB file holding `json` and, when `bin` is not empty, a BIN chunk. Chunks are padded
@@ -332,12 +373,6 @@ pub(crate) fn glb_bytes(json: &Value, bin: &[u8]) -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn percent_escapes_decode() {
-        assert_eq!(percent_decode("a%20b.bin").unwrap(), "a b.bin");
-        assert!(percent_decode("a%2").is_err());
-    }
 
     #[test]
     fn glb_round_trips_through_split() {

@@ -2,7 +2,6 @@
 //! (regions, weights) and line segments (cut curves, bones).
 
 use super::builder::{GlbBuilder, ARRAY_BUFFER};
-use crate::output::write_atomically;
 use crate::IoError;
 use glam::Vec3;
 use serde_json::{json, Map};
@@ -12,7 +11,8 @@ use std::path::Path;
 const LINES: u32 = 1;
 const TRIANGLES: u32 = 4;
 
-/// Writes a glTF binary with a TRIANGLES primitive and a LINES primitive.
+/// A glTF binary with a TRIANGLES primitive and a LINES primitive (`out`, where it will
+/// be written, only names it in errors).
 ///
 /// - `positions`: #V vertex positions; `triangles`: #F index triples into them.
 /// - `vertex_colors`: #V linear RGBA colours in [0, 1] (COLOR_0), or empty for none.
@@ -22,16 +22,15 @@ const TRIANGLES: u32 = 4;
 ///
 /// # Errors
 /// [`IoError::Invalid`] when there is nothing to draw, a triangle index is out of range,
-/// the colour count differs from the vertex count, or a value is not finite;
-/// [`IoError::Write`] when writing fails (no file is left behind).
-pub fn write_debug_glb(
+/// the colour count differs from the vertex count, or a value is not finite.
+pub fn debug_glb(
     positions: &[Vec3],
     triangles: &[[u32; 3]],
     vertex_colors: &[[f32; 4]],
     lines: &[[Vec3; 2]],
     line_color: [f32; 4],
     out: &Path,
-) -> Result<(), IoError> {
+) -> Result<Vec<u8>, IoError> {
     let invalid = |message: String| IoError::invalid(out, message);
     if triangles.is_empty() && lines.is_empty() {
         return Err(invalid("nothing to write: no triangle and no line".into()));
@@ -96,5 +95,5 @@ pub fn write_debug_glb(
     builder.push_item("nodes", json!({"name": "debug", "mesh": 0}));
     builder.push_item("scenes", json!({"nodes": [0]}));
     builder.json_mut().insert("scene".into(), json!(0));
-    write_atomically(out, None, &builder.finish())
+    Ok(builder.finish())
 }

@@ -1,22 +1,32 @@
 //! Checked access to the raw glTF JSON: every lookup that can fail names the JSON location
 //! (e.g. `nodes[3].children`) in an [`IoError`] naming the file.
 
+use super::budget::DecodeBudget;
 use crate::IoError;
 use serde_json::Value;
 use std::path::Path;
 
-/// A parsed glTF document with its loaded buffers, borrowed for reading.
+/// A parsed glTF document with its loaded buffers and what it may still decode, borrowed
+/// for reading.
 #[derive(Clone, Copy)]
 pub(crate) struct Document<'a> {
     pub json: &'a Value,
     pub buffers: &'a [Vec<u8>],
     pub path: &'a Path,
+    pub budget: &'a DecodeBudget,
 }
 
 impl<'a> Document<'a> {
     /// An [`IoError::Invalid`] about this document.
     pub fn error(&self, message: impl Into<String>) -> IoError {
         IoError::invalid(self.path, message)
+    }
+
+    /// Takes `bytes` about to be decoded for `role` from the budget; an error past it.
+    pub fn charge(&self, bytes: u64, role: &str) -> Result<(), IoError> {
+        self.budget
+            .charge(bytes)
+            .map_err(|e| self.error(format!("{role}: {e}")))
     }
 
     /// The top-level array `key` (`nodes`, `meshes`, ...); empty when absent.

@@ -7,10 +7,12 @@
 
 mod accessor;
 mod animation;
+mod budget;
 mod builder;
 mod container;
 mod debug;
 mod document;
+mod file_access;
 mod new_document;
 mod nodes;
 mod prune;
@@ -19,9 +21,11 @@ mod rewrite;
 mod view_span;
 mod write;
 
-pub use debug::write_debug_glb;
+pub use budget::{DECODED_FLOOR_BYTES, DECODED_PER_INPUT_BYTE, MAX_DECODED_BYTES};
+pub use container::{ImageBytes, MAX_LOADED_BYTES};
+pub use debug::debug_glb;
 pub use read::read;
-pub use write::{write_skinned_glb, WriteOptions};
+pub use write::{skinned_glb, write_skinned_glb, WriteOptions, MAX_INFLUENCES};
 
 use serde_json::Value;
 use std::ops::Range;
@@ -30,13 +34,19 @@ use std::ops::Range;
 ///
 /// - `document`: the whole JSON document, untouched.
 /// - `buffers`: the bytes of every buffer, in `document.buffers` order.
+/// - `images`: the bytes of every image given by `uri`, in `document.images` order; `None`
+///   for images in a bufferView and for those the reader left out (with a warning).
 /// - `skin`: the skin whose joints are the character's skeleton, if any.
+/// - `inverse_binds_cleaned`: the skin's inverse bind matrices were projective and the
+///   skeleton holds affine ones (the writer then writes the skeleton's).
 /// - `primitives`: every primitive read into `Character::mesh`, in mesh order.
 #[derive(Clone)]
 pub struct GltfSource {
     pub document: Value,
     pub buffers: Vec<Vec<u8>>,
+    pub images: Vec<Option<ImageBytes>>,
     pub skin: Option<usize>,
+    pub inverse_binds_cleaned: bool,
     pub primitives: Vec<PrimitiveSource>,
 }
 

@@ -2,7 +2,9 @@
 
 use super::animation::append_clips;
 use super::builder::{GlbBuilder, ARRAY_BUFFER};
-use super::write::{merge_asset_extras, pack_weights, push_weight_accessors, WriteOptions};
+use super::write::{
+    merge_asset_extras, pack_weights, push_inverse_binds, push_weight_accessors, WriteOptions,
+};
 use crate::{Character, IoError};
 use atlas_skin_runtime::{Skeleton, VertexWeights};
 use glam::Vec3;
@@ -115,12 +117,7 @@ pub(crate) fn new_document(
         }
         builder.push_item("nodes", node);
     }
-    let inverse_bind: Vec<f32> = skeleton
-        .inverse_bind
-        .iter()
-        .flat_map(|m| m.to_cols_array())
-        .collect();
-    let inverse_bind = builder.push_f32_accessor(&inverse_bind, "MAT4", false, None);
+    let inverse_bind = push_inverse_binds(&mut builder, skeleton);
     let roots: Vec<usize> = (0..skeleton.len())
         .filter(|&j| skeleton.parent(j).is_none())
         .collect();

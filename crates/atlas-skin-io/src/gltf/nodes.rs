@@ -3,6 +3,7 @@
 use super::document::{opt_str, Document};
 use crate::names::unique_names;
 use crate::IoError;
+use atlas_skin_runtime::forest::find_cycle;
 use atlas_skin_runtime::Trs;
 use glam::{Mat4, Quat, Vec3};
 use std::collections::HashSet;
@@ -40,33 +41,33 @@ impl NodeTree {
             }
             local.push(local_transform(doc, node, &location)?);
         }
-        for start in 0..nodes.len() {
-            // A walk up longer than the node count must revisit a node.
-            let mut current = start;
-            for _ in 0..=nodes.len() {
-                match parents[current] {
-                    Some(parent) if parent == start => {
-                        return Err(doc.error(format!(
-                            "the node hierarchy has a cycle through node {start}"
-                        )))
-                    }
-                    Some(parent) => current = parent,
-                    None => break,
-                }
-            }
+        if let Some(node) = find_cycle(nodes.len(), |n| parents[n]) {
+            return Err(doc.error(format!(
+                "the node hierarchy has a cycle through node {node}"
+            )));
         }
         Ok(Self { parents, local })
     }
 
-    /// World transform of `node`: the product of the local matrices from its root down.
-    pub fn world(&self, node: usize) -> Mat4 {
-        let mut world = self.local[node].matrix();
-        let mut current = node;
-        while let Some(parent) = self.parents[current] {
-            world = self.local[parent].matrix() * world;
-            current = parent;
+    /// World transform of every node: the product of the local matrices from its root
+    /// down. Each node's is computed once, from its parent's (linear in the node count,
+    /// whatever the order of the nodes).
+    pub fn worlds(&self) -> Vec<Mat4> {
+        let mut worlds: Vec<Option<Mat4>> = vec![None; self.parents.len()];
+        let mut path = Vec::new();
+        for start in 0..self.parents.len() {
+            let mut current = Some(start);
+            while let Some(node) = current.filter(|&n| worlds[n].is_none()) {
+                path.push(node);
+                current = self.parents[node];
+            }
+            let mut above = current.and_then(|n| worlds[n]).unwrap_or(Mat4::IDENTITY);
+            for node in path.drain(..).rev() {
+                above *= self.local[node].matrix();
+                worlds[node] = Some(above);
+            }
         }
-        world
+        worlds.into_iter().flatten().collect()
     }
 }
 
@@ -146,11 +147,15 @@ mod tests {
             json: &json,
             buffers: &[],
             path: Path::new("names.gltf"),
+            budget: &crate::gltf::budget::DecodeBudget::for_input(0),
         };
         let names = unique_node_names(&doc, &[1]).unwrap();
         assert_eq!(names, ["a.1", "a", "node2", "node2.1", "node4"]);
         let tree = NodeTree::new(&doc).unwrap();
         assert_eq!(tree.parents[0], Some(4));
-        assert_eq!(tree.world(0).w_axis.truncate(), Vec3::new(0.0, 0.0, 5.0));
+        let worlds = tree.worlds();
+        assert_eq!(worlds[0].w_axis.truncate(), Vec3::new(0.0, 0.0, 5.0));
+        assert_eq!(worlds[4], worlds[0]);
+        assert_eq!(worlds[1], Mat4::IDENTITY);
     }
 }

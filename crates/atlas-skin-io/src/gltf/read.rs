@@ -3,6 +3,7 @@
 
 use super::accessor::{read_floats, read_uints};
 use super::animation::{read_clips, read_rig};
+use super::budget::DecodeBudget;
 use super::container::read_container;
 use super::document::Document;
 use super::nodes::{unique_node_names, NodeTree};
@@ -32,10 +33,12 @@ use std::path::Path;
 /// JSON, out-of-range accessors or indices, non-finite positions, node cycles.
 pub fn read(path: &Path) -> Result<Character, IoError> {
     let mut container = read_container(path)?;
+    let budget = DecodeBudget::for_input(container.input_bytes);
     let doc = Document {
         json: &container.json,
         buffers: &container.buffers,
         path,
+        budget: &budget,
     };
     reject_compressed_geometry(&doc)?;
     let tree = NodeTree::new(&doc)?;
@@ -55,10 +58,13 @@ pub fn read(path: &Path) -> Result<Character, IoError> {
             "the document has no mesh node with triangles"
         }));
     }
+    let mut inverse_binds_cleaned = false;
     let (skeleton, reference_weights) = match skin {
         Some(skin) => {
             let joint_names = joints.iter().map(|&n| names[n].clone()).collect();
-            let skeleton = read_skeleton(&doc, &tree, skin, &joints, joint_names)?;
+            let (skeleton, cleaned) =
+                read_skeleton(&doc, &tree, skin, &joints, joint_names, &mut warnings)?;
+            inverse_binds_cleaned = cleaned;
             let weights = read_reference_weights(&doc, &geometry.blocks, joints.len())?;
             (Some(skeleton), weights)
         }
@@ -73,10 +79,12 @@ pub fn read(path: &Path) -> Result<Character, IoError> {
     character.clips = clips;
     character.warnings = warnings;
     character.gltf = Some(GltfSource {
+        inverse_binds_cleaned,
         skin,
         primitives: geometry.primitives,
         document: container.json,
         buffers: container.buffers,
+        images: container.images,
     });
     Ok(character)
 }
@@ -154,6 +162,11 @@ fn mesh_instances(
     skin: Option<usize>,
 ) -> Result<Vec<MeshInstance>, IoError> {
     let mesh_count = doc.array("meshes")?.len();
+    let worlds = if skin.is_none() {
+        tree.worlds()
+    } else {
+        Vec::new()
+    };
     let mut instances: Vec<MeshInstance> = Vec::new();
     for (node, object) in doc.array("nodes")?.iter().enumerate() {
         let location = format!("nodes[{node}]");
@@ -179,7 +192,7 @@ fn mesh_instances(
             None => instances.push(MeshInstance {
                 node,
                 mesh,
-                world: Some(tree.world(node)),
+                world: worlds.get(node).copied(),
             }),
         }
     }
@@ -267,13 +280,18 @@ fn read_geometry<'a>(
                 Some(accessor) => {
                     read_uints(doc, accessor, "SCALAR", &format!("{location}.indices"))?
                 }
-                None => (0..vertex_count as u32).collect(),
+                None => {
+                    doc.charge(4 * vertex_count as u64, &location)?;
+                    (0..vertex_count as u32).collect()
+                }
             };
             if let Some(bad) = indices.iter().find(|&&i| i as usize >= vertex_count) {
                 return Err(doc.error(format!(
                     "{location}: index {bad} is out of range of its {vertex_count} vertices"
                 )));
             }
+            // A strip or fan makes 3 indices (12 bytes) of each index.
+            doc.charge(12 * indices.len() as u64, &location)?;
             let first_triangle = mesh.triangles.len();
             let offset = first as u32;
             mesh.triangles.extend(
@@ -360,16 +378,41 @@ fn triangles_of(
         .collect())
 }
 
-/// The skeleton of `skin` over its `joints` (node indices).
+/// An inverse bind matrix made affine (glTF 2.0 asks for a last row of (0, 0, 0, 1)): a
+/// last row (0, 0, 0, w) with w ≠ 0 divides the matrix by w (the same transform in
+/// homogeneous coordinates); any other last row is replaced by (0, 0, 0, 1). `None` when
+/// the matrix is affine already.
+fn affine_inverse_bind(m: Mat4) -> Option<Mat4> {
+    let last_row = m.row(3);
+    if last_row == glam::Vec4::W {
+        return None;
+    }
+    let scaled = if last_row.truncate() == Vec3::ZERO && last_row.w != 0.0 {
+        m * (1.0 / last_row.w)
+    } else {
+        m
+    };
+    let mut columns = scaled.to_cols_array_2d();
+    for column in &mut columns[..3] {
+        column[3] = 0.0;
+    }
+    columns[3][3] = 1.0;
+    Some(Mat4::from_cols_array_2d(&columns))
+}
+
+/// The skeleton of `skin` over its `joints` (node indices), and whether projective inverse
+/// bind matrices were made affine ([`affine_inverse_bind`], with a warning).
 fn read_skeleton(
     doc: &Document,
     tree: &NodeTree,
     skin: usize,
     joints: &[usize],
     names: Vec<String>,
-) -> Result<Skeleton, IoError> {
+    warnings: &mut Vec<String>,
+) -> Result<(Skeleton, bool), IoError> {
     let location = format!("skins[{skin}]");
     let object = doc.item("skins", skin)?;
+    let mut cleaned = Vec::new();
     let inverse_bind = match doc.opt_index(object, &location, "inverseBindMatrices")? {
         None => vec![Mat4::IDENTITY; joints.len()],
         Some(accessor) => {
@@ -382,7 +425,22 @@ fn read_skeleton(
                     joints.len()
                 )));
             }
-            values.chunks_exact(16).map(Mat4::from_cols_slice).collect()
+            let mut matrices: Vec<Mat4> =
+                values.chunks_exact(16).map(Mat4::from_cols_slice).collect();
+            for (joint, matrix) in matrices.iter_mut().enumerate() {
+                if let Some(affine) = affine_inverse_bind(*matrix) {
+                    cleaned.push(joint);
+                    *matrix = affine;
+                }
+            }
+            if let Some(&first) = cleaned.first() {
+                warnings.push(format!(
+                    "{role}: {} matrices (first: joint {first}) are projective (last row not \
+                     (0, 0, 0, 1)); made affine, and written so",
+                    cleaned.len()
+                ));
+            }
+            matrices
         }
     };
     let joint_of: HashMap<usize, u32> = joints
@@ -403,10 +461,12 @@ fn read_skeleton(
             NO_PARENT
         })
         .collect();
-    Skeleton::new(names, parents, inverse_bind).map_err(|cause| IoError::Skeleton {
-        path: doc.path.to_path_buf(),
-        cause,
-    })
+    let skeleton =
+        Skeleton::new(names, parents, inverse_bind).map_err(|cause| IoError::Skeleton {
+            path: doc.path.to_path_buf(),
+            cause,
+        })?;
+    Ok((skeleton, !cleaned.is_empty()))
 }
 
 /// The stored JOINTS_n/WEIGHTS_n of every vertex block, as stored (zeros dropped); `None`
@@ -468,4 +528,24 @@ fn read_reference_weights(
         rows.extend(block_rows);
     }
     Ok(any.then(|| VertexWeights::from_rows(rows)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn projective_inverse_binds_become_affine() {
+        let affine = Mat4::from_translation(Vec3::new(1.0, 2.0, 3.0));
+        assert_eq!(affine_inverse_bind(affine), None);
+        // The same transform with homogeneous weight 2.
+        let doubled = affine * 2.0;
+        assert_eq!(affine_inverse_bind(doubled), Some(affine));
+        let mut projective = affine.to_cols_array_2d();
+        projective[0][3] = 0.5;
+        assert_eq!(
+            affine_inverse_bind(Mat4::from_cols_array_2d(&projective)),
+            Some(affine)
+        );
+    }
 }

@@ -1,10 +1,11 @@
 //! New skin weights into a copy of the input glTF document, everything else preserved.
 
 use super::animation::append_clips;
-use super::builder::GlbBuilder;
-use super::container::load_uri;
+use super::builder::{component_bounds, GlbBuilder};
 use super::prune::{drop_orphans, References};
-use super::write::{merge_asset_extras, pack_weights, push_weight_accessors, WriteOptions};
+use super::write::{
+    merge_asset_extras, pack_weights, push_inverse_binds, push_weight_accessors, WriteOptions,
+};
 use super::GltfSource;
 use crate::{Character, IoError};
 use atlas_skin_runtime::VertexWeights;
@@ -36,10 +37,12 @@ pub(crate) fn rewrite_document(
             "the glTF document is not a JSON object",
         ));
     };
+    let skinned_meshes: BTreeSet<usize> = source.primitives.iter().map(|p| p.mesh).collect();
+    refuse_joints_with_skinned_meshes(&json, source.skin, &skinned_meshes, input)?;
     let mut builder = GlbBuilder::new(json);
     let input_references = References::of_input(builder.json_mut());
     copy_buffer_views(&mut builder, source, input)?;
-    embed_images(&mut builder, input)?;
+    embed_images(&mut builder, source, input)?;
 
     let joint_nodes = skin_joint_nodes(&source.document, source.skin, input)?;
     let joint_count = character.skeleton.as_ref().map_or(0, |s| s.len());
@@ -61,8 +64,23 @@ pub(crate) fn rewrite_document(
         let accessors = push_weight_accessors(&mut builder, &packed, joint_count);
         new_sets.insert(primitive.position_accessor, accessors);
     }
-    let skinned_meshes: BTreeSet<usize> = source.primitives.iter().map(|p| p.mesh).collect();
     replace_weight_attributes(builder.json_mut(), &skinned_meshes, &new_sets);
+    set_position_bounds(builder.json_mut(), character, source);
+    if let (true, Some(skeleton), Some(skin)) = (
+        source.inverse_binds_cleaned,
+        character.skeleton.as_ref(),
+        source.skin,
+    ) {
+        let accessor = push_inverse_binds(&mut builder, skeleton);
+        let skin = builder
+            .json_mut()
+            .get_mut("skins")
+            .and_then(|skins| skins.get_mut(skin))
+            .and_then(Value::as_object_mut);
+        if let Some(skin) = skin {
+            skin.insert("inverseBindMatrices".into(), json!(accessor));
+        }
+    }
 
     append_clips(&mut builder, &options.animations, &joint_nodes, out)?;
     if let Some(extras) = &options.extras {
@@ -70,6 +88,83 @@ pub(crate) fn rewrite_document(
     }
     Ok(drop_orphans(builder, input_references.as_ref()).finish())
 }
+
+/// Refuses a document where a joint of `skin` instantiates one of the skinned `meshes`: the
+/// mesh would move with a joint that its own weights move (and a node with a skinned mesh
+/// but no skin is invalid glTF).
+fn refuse_joints_with_skinned_meshes(
+    json: &Map<String, Value>,
+    skin: Option<usize>,
+    meshes: &BTreeSet<usize>,
+    input: &Path,
+) -> Result<(), IoError> {
+    let joints = skin
+        .and_then(|skin| json.get("skins")?.get(skin)?.get("joints")?.as_array())
+        .into_iter()
+        .flatten()
+        .filter_map(Value::as_u64);
+    for node in joints {
+        let mesh = json
+            .get("nodes")
+            .and_then(|nodes| nodes.get(node as usize)?.get("mesh")?.as_u64());
+        if let Some(mesh) = mesh.filter(|m| meshes.contains(&(*m as usize))) {
+            return Err(IoError::invalid(
+                input,
+                format!(
+                    "nodes[{node}] is a joint of the skin and also instantiates the skinned \
+                     meshes[{mesh}]: cannot write a valid skinned glTF (move the mesh to a \
+                     node of its own)"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Sets `min`/`max` of every float POSITION accessor read into the character (glTF 2.0
+/// requires them) from the positions as read, where they are missing or wrong.
+fn set_position_bounds(json: &mut Map<String, Value>, character: &Character, source: &GltfSource) {
+    let Some(Value::Array(accessors)) = json.get_mut("accessors") else {
+        return;
+    };
+    for primitive in &source.primitives {
+        let Some(Value::Object(accessor)) = accessors.get_mut(primitive.position_accessor) else {
+            continue;
+        };
+        if accessor.get("componentType").and_then(Value::as_u64) != Some(FLOAT) {
+            continue;
+        }
+        let Some(positions) = character.mesh.positions.get(primitive.vertices.clone()) else {
+            continue;
+        };
+        let values: Vec<f32> = positions.iter().flat_map(|p| p.to_array()).collect();
+        if values.is_empty() {
+            continue;
+        }
+        let (min, max) = component_bounds(&values, 3);
+        for (key, bound) in [("min", min), ("max", max)] {
+            if !same_numbers(accessor.get(key), &bound) {
+                accessor.insert(key.into(), json!(bound));
+            }
+        }
+    }
+}
+
+/// True when `value` is an array of the numbers `expected` (as float32: `1` and `1.0`
+/// are the same bound).
+fn same_numbers(value: Option<&Value>, expected: &[f32]) -> bool {
+    let Some(Value::Array(items)) = value else {
+        return false;
+    };
+    items.len() == expected.len()
+        && items
+            .iter()
+            .zip(expected)
+            .all(|(item, &e)| item.as_f64().is_some_and(|v| v as f32 == e))
+}
+
+/// glTF's code of the FLOAT component type.
+const FLOAT: u64 = 5126;
 
 /// Copies every bufferView's bytes into the output buffer and points the view at it.
 fn copy_buffer_views(
@@ -107,19 +202,31 @@ fn copy_buffer_views(
     Ok(())
 }
 
-/// Embeds every image given by URI (a file beside the input or a `data:` URI) as a
-/// bufferView with its `mimeType`.
-fn embed_images(builder: &mut GlbBuilder, input: &Path) -> Result<(), IoError> {
-    let Some(Value::Array(mut images)) = builder.json_mut().remove("images") else {
+/// Embeds every image given by URI (read with the document: a file beside the input or a
+/// `data:` URI) as a bufferView with its `mimeType`. Images the reader left out are
+/// removed, with the textures' `source` references renumbered (a texture whose image was
+/// left out keeps no `source`).
+fn embed_images(
+    builder: &mut GlbBuilder,
+    source: &GltfSource,
+    input: &Path,
+) -> Result<(), IoError> {
+    let Some(Value::Array(images)) = builder.json_mut().remove("images") else {
         return Ok(());
     };
-    for (index, image) in images.iter_mut().enumerate() {
+    let mut kept = Vec::with_capacity(images.len());
+    let mut new_index = Vec::with_capacity(images.len());
+    for (index, mut image) in images.into_iter().enumerate() {
         let Some(uri) = image.get("uri").and_then(Value::as_str).map(str::to_string) else {
+            new_index.push(Some(kept.len()));
+            kept.push(image);
             continue;
         };
-        let (bytes, declared_type) = load_uri(input, &uri)
-            .map_err(|e| IoError::invalid(input, format!("images[{index}]: {e}")))?;
-        let mime_type = sniff_image_type(&bytes)
+        let Some(Some(read)) = source.images.get(index) else {
+            new_index.push(None);
+            continue;
+        };
+        let mime_type = sniff_image_type(&read.bytes)
             .map(str::to_string)
             .or_else(|| {
                 image
@@ -127,24 +234,63 @@ fn embed_images(builder: &mut GlbBuilder, input: &Path) -> Result<(), IoError> {
                     .and_then(Value::as_str)
                     .map(str::to_string)
             })
-            .or(declared_type)
+            .or_else(|| read.media_type.clone())
             .ok_or_else(|| {
                 IoError::invalid(
                     input,
                     format!("images[{index}] ({uri}) has an unknown type"),
                 )
             })?;
-        let view = builder.push_view(&bytes, None);
-        if let Value::Object(image) = image {
-            image.remove("uri");
-            image.insert("bufferView".into(), json!(view));
-            image.insert("mimeType".into(), json!(mime_type));
+        let view = builder.push_view(&read.bytes, None);
+        if let Value::Object(object) = &mut image {
+            object.remove("uri");
+            object.insert("bufferView".into(), json!(view));
+            object.insert("mimeType".into(), json!(mime_type));
+        }
+        new_index.push(Some(kept.len()));
+        kept.push(image);
+    }
+    if let Some(Value::Array(textures)) = builder.json_mut().get_mut("textures") {
+        for texture in textures {
+            renumber_image_sources(texture, &new_index);
         }
     }
-    builder
-        .json_mut()
-        .insert("images".into(), Value::Array(images));
+    // glTF does not allow an empty top-level array.
+    if !kept.is_empty() {
+        builder
+            .json_mut()
+            .insert("images".into(), Value::Array(kept));
+    }
     Ok(())
+}
+
+/// Renumbers the `source` of a texture and of its extensions (`EXT_texture_webp`,
+/// `KHR_texture_basisu`, ...) by `new_index`, removing a `source` whose image is gone.
+fn renumber_image_sources(texture: &mut Value, new_index: &[Option<usize>]) {
+    let Value::Object(object) = texture else {
+        return;
+    };
+    let renumber = |object: &mut Map<String, Value>| {
+        let Some(old) = object.get("source").and_then(Value::as_u64) else {
+            return;
+        };
+        match new_index.get(old as usize).copied().flatten() {
+            Some(new) => {
+                object.insert("source".into(), json!(new));
+            }
+            None => {
+                object.remove("source");
+            }
+        }
+    };
+    renumber(object);
+    if let Some(Value::Object(extensions)) = object.get_mut("extensions") {
+        for extension in extensions.values_mut() {
+            if let Value::Object(extension) = extension {
+                renumber(extension);
+            }
+        }
+    }
 }
 
 /// The media type of image bytes recognised by their signature.

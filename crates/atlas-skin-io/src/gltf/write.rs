@@ -5,17 +5,21 @@ use super::accessor::ComponentType;
 use super::builder::{GlbBuilder, ARRAY_BUFFER};
 use super::new_document::new_document;
 use super::rewrite::rewrite_document;
-use crate::output::write_atomically;
+use crate::output::OutputPlan;
 use crate::{Character, IoError};
-use atlas_skin_runtime::{Clip, VertexWeights};
+use atlas_skin_runtime::{Clip, Skeleton, VertexWeights};
 use serde_json::{Map, Value};
 use std::path::Path;
+
+/// Largest [`WriteOptions::max_influences`]: 8 JOINTS_n/WEIGHTS_n sets, beyond what any
+/// engine skins with.
+pub const MAX_INFLUENCES: usize = 32;
 
 /// What the skinned writer adds to the document.
 #[derive(Debug, Clone)]
 pub struct WriteOptions {
     /// Largest number of joints per vertex (4 per JOINTS_n/WEIGHTS_n set; > 4 writes
-    /// JOINTS_1/WEIGHTS_1, ...). At least 1.
+    /// JOINTS_1/WEIGHTS_1, ...). From 1 to [`MAX_INFLUENCES`].
     pub max_influences: usize,
     /// Extra clips to add; `Track::node` is a skeleton joint index, mapped to the joint's
     /// node in the output.
@@ -56,11 +60,32 @@ pub fn write_skinned_glb(
     options: &WriteOptions,
     out: &Path,
 ) -> Result<(), IoError> {
+    let plan = OutputPlan::new([character.path.as_path()], [out])?;
+    plan.write(out, &skinned_glb(character, weights, options, out)?)
+}
+
+/// The bytes [`write_skinned_glb`] writes (`out` only names the output in errors), for
+/// callers that write through their own [`OutputPlan`].
+///
+/// # Errors
+/// As [`write_skinned_glb`], without the write errors.
+pub fn skinned_glb(
+    character: &Character,
+    weights: &VertexWeights,
+    options: &WriteOptions,
+    out: &Path,
+) -> Result<Vec<u8>, IoError> {
     let skeleton = character.skeleton.as_ref().ok_or_else(|| {
         IoError::invalid(&character.path, "cannot write a skinned glTF: no skeleton")
     })?;
-    if options.max_influences == 0 {
-        return Err(IoError::invalid(out, "max_influences must be at least 1"));
+    if !(1..=MAX_INFLUENCES).contains(&options.max_influences) {
+        return Err(IoError::invalid(
+            out,
+            format!(
+                "max_influences is {}, outside 1..={MAX_INFLUENCES}",
+                options.max_influences
+            ),
+        ));
     }
     if weights.vertex_count() != character.mesh.positions.len() {
         return Err(IoError::invalid(
@@ -75,13 +100,12 @@ pub fn write_skinned_glb(
     weights
         .validate(skeleton.len())
         .map_err(|e| IoError::invalid(out, format!("bad weights: {e}")))?;
-    let bytes = match character.gltf.as_ref() {
+    match character.gltf.as_ref() {
         Some(source) if source.skin.is_some() => {
-            rewrite_document(character, source, weights, options, out)?
+            rewrite_document(character, source, weights, options, out)
         }
-        _ => new_document(character, skeleton, weights, options, out)?,
-    };
-    write_atomically(out, Some(character.path.as_path()), &bytes)
+        _ => new_document(character, skeleton, weights, options, out),
+    }
 }
 
 /// Skin weights packed into glTF's fixed-width JOINTS_n/WEIGHTS_n sets.
@@ -163,6 +187,16 @@ fn stored_weights(mut row: Vec<(u32, f32)>) -> Vec<(u32, f32)> {
             None => return stored,
         }
     }
+}
+
+/// Appends the inverse bind matrices of `skeleton` as a MAT4 accessor; returns its index.
+pub(crate) fn push_inverse_binds(builder: &mut GlbBuilder, skeleton: &Skeleton) -> usize {
+    let matrices: Vec<f32> = skeleton
+        .inverse_bind
+        .iter()
+        .flat_map(|m| m.to_cols_array())
+        .collect();
+    builder.push_f32_accessor(&matrices, "MAT4", false, None)
 }
 
 /// Appends packed weights as JOINTS/WEIGHTS accessors (joints as UNSIGNED_BYTE below 256

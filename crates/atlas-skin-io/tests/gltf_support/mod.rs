@@ -25,6 +25,20 @@ pub fn model_path(model: &str, file: &str) -> PathBuf {
     atlas_skin_corpus::models_dir().join(model).join(file)
 }
 
+/// SimpleSkin.gltf's JSON with its (embedded) buffer 0 decoded.
+pub fn simpleskin() -> (Value, Vec<u8>) {
+    use base64::Engine;
+    let json: Value = serde_json::from_slice(
+        &std::fs::read(model_path("simpleskin", "SimpleSkin.gltf")).unwrap(),
+    )
+    .unwrap();
+    let uri = json["buffers"][0]["uri"].as_str().unwrap();
+    let buffer0 = base64::engine::general_purpose::STANDARD
+        .decode(uri.split_once(',').unwrap().1)
+        .unwrap();
+    (json, buffer0)
+}
+
 /// The manifest.json of the corpus model `model`.
 pub fn manifest(model: &str) -> Value {
     atlas_skin_corpus::find(model)
