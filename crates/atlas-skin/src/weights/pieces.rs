@@ -111,15 +111,17 @@ pub fn weight_pieces(
         return counts;
     }
 
-    let mut rows: Vec<Option<Vec<(u32, f64)>>> = vec![None; n];
+    let mut rows: Vec<Option<Row>> = vec![None; n];
     fill_body_gaps(decomposition, weights, &empty, &mut rows, &mut counts);
     let loose: Vec<usize> = (0..piece_count).filter(|&c| !is_body[c]).collect();
     if !loose.is_empty() {
         let body = BodySurface::new(surface, &decomposition.face_region, decomposition, weights);
         let segments = bone_segments(skeleton);
-        for &c in &loose {
-            let treatment =
-                weight_loose_piece(surface, &members[c], &body, weights, &segments, &mut rows);
+        let weighted: Vec<(PieceTreatment, Vec<Row>)> = loose
+            .par_iter()
+            .map(|&c| weight_loose_piece(surface, &members[c], &body, weights, &segments))
+            .collect();
+        for (&c, (treatment, piece_rows)) in loose.iter().zip(weighted) {
             match treatment {
                 PieceTreatment::Attached => counts.attached += members[c].len(),
                 PieceTreatment::Rigid(_) => counts.rigid += members[c].len(),
@@ -127,6 +129,9 @@ pub fn weight_pieces(
                 PieceTreatment::Body => {}
             }
             pieces[c].treatment = treatment;
+            for (&v, row) in members[c].iter().zip(piece_rows) {
+                rows[v as usize] = Some(row);
+            }
         }
     }
     let mut filled = SurfaceWeights {
@@ -151,7 +156,7 @@ fn fill_body_gaps(
     decomposition: &Decomposition,
     weights: &SurfaceWeights,
     empty: &[bool],
-    rows: &mut [Option<Vec<(u32, f64)>>],
+    rows: &mut [Option<Row>],
     counts: &mut WeightCounts,
 ) {
     let n = empty.len();
@@ -231,57 +236,57 @@ struct BodyPoint {
     distance: f64,
 }
 
-/// Weights one piece without joints (module documentation) into `rows`; returns how.
+/// A row of (joint, weight) pairs.
+type Row = Vec<(u32, f64)>;
+
+/// Weights one piece without joints (module documentation): how, and the row of each of
+/// `vertices`. The body surface is asked only when the nearest bones are not unanimous.
 fn weight_loose_piece(
     surface: &SurfaceMesh,
     vertices: &[u32],
     body: &BodySurface,
     weights: &SurfaceWeights,
     segments: &[(u32, DVec3, DVec3)],
-    rows: &mut [Option<Vec<(u32, f64)>>],
-) -> PieceTreatment {
-    let found: Vec<(Option<NearestBone>, Option<BodyPoint>)> = vertices
+) -> (PieceTreatment, Vec<Row>) {
+    let position = |v: u32| surface.positions[v as usize];
+    let bones: Vec<Option<NearestBone>> = vertices
         .par_iter()
-        .map(|&v| {
-            let p = surface.positions[v as usize];
-            (
-                nearest_bone_with_distance(segments, p),
-                body.weights_at(weights, p),
-            )
+        .map(|&v| nearest_bone_with_distance(segments, position(v)))
+        .collect();
+    let joints: Vec<Option<u32>> = bones.iter().map(|b| b.map(|b| b.joint)).collect();
+    let rigid = |joint: u32| {
+        (
+            PieceTreatment::Rigid(joint),
+            vec![vec![(joint, 1.0)]; vertices.len()],
+        )
+    };
+    let Some(dominant) = most_frequent(&joints) else {
+        return (PieceTreatment::Bones, vec![Row::new(); vertices.len()]);
+    };
+    if joints.iter().all(|&j| j == Some(dominant)) {
+        return rigid(dominant);
+    }
+    let on_body: Option<Vec<Row>> = vertices
+        .par_iter()
+        .zip(&bones)
+        .map(|(&v, bone)| {
+            let at = body.weights_at(weights, position(v))?;
+            (at.distance < bone.map_or(f64::INFINITY, |b| b.distance)).then_some(at.row)
         })
         .collect();
-    let bone_distance = |b: &Option<NearestBone>| b.map_or(f64::INFINITY, |b| b.distance);
-    let joints: Vec<Option<u32>> = found.iter().map(|(b, _)| b.map(|b| b.joint)).collect();
-    let Some(dominant) = most_frequent(&joints) else {
-        return PieceTreatment::Bones;
-    };
-    let unanimous = joints.iter().all(|&j| j == Some(dominant));
-    let on_body = found.iter().all(|(bone, at)| {
-        at.as_ref()
-            .is_some_and(|a| a.distance < bone_distance(bone))
-    });
-    if !unanimous && on_body {
-        for (&v, (_, at)) in vertices.iter().zip(found) {
-            rows[v as usize] = at.map(|a| a.row);
-        }
-        return PieceTreatment::Attached;
+    if let Some(rows) = on_body {
+        return (PieceTreatment::Attached, rows);
     }
-    let positions: Vec<DVec3> = vertices
-        .iter()
-        .map(|&v| surface.positions[v as usize])
-        .collect();
+    let positions: Vec<DVec3> = vertices.iter().map(|&v| position(v)).collect();
     let (lo, hi) = crate::geometry::bounding_box(&positions);
-    let small = (hi - lo).length() <= longest_bone(segments, dominant);
-    let rigid = small || unanimous;
-    for (&v, j) in vertices.iter().zip(joints) {
-        let joint = if rigid { Some(dominant) } else { j };
-        rows[v as usize] = Some(joint.map(|j| (j, 1.0)).into_iter().collect());
+    if (hi - lo).length() <= longest_bone(segments, dominant) {
+        return rigid(dominant);
     }
-    if rigid {
-        PieceTreatment::Rigid(dominant)
-    } else {
-        PieceTreatment::Bones
-    }
+    let rows = joints
+        .into_iter()
+        .map(|j| j.map(|j| (j, 1.0)).into_iter().collect())
+        .collect();
+    (PieceTreatment::Bones, rows)
 }
 
 /// Length of the longest bone segment of `joint`.
