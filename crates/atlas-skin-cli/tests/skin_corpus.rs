@@ -115,6 +115,13 @@ fn skin_runs_on_every_corpus_model_and_writes_valid_bound_skins() {
                 model.name
             );
         }
+        let body = &report["pieces"]["by_treatment"]["body"];
+        assert!(
+            body["pieces"].as_u64().unwrap_or(0) >= 1 && body["vertices"].is_u64(),
+            "{}: pieces {}",
+            model.name,
+            report["pieces"]
+        );
         let joints = report["decomposition"]["joints"]
             .as_array()
             .expect("joints");

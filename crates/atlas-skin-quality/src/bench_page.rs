@@ -274,7 +274,10 @@ fn skin_report(
          `--report` JSON over its `counts.vertices`): {} on average per character, {} of {} \
          vertices overall ({}); {} of {} characters have some (goal: 0 on every character). \
          The count is of welded surface vertices (coincident vertices count once) plus stored \
-         vertices no triangle uses, over the stored vertices, as issue 12 counts it.",
+         vertices no triangle uses, over the stored vertices, as issue 12 counts it: vertices \
+         of decomposed pieces that no region reaches and of pieces bound vertex by vertex to \
+         their nearest bone (the report's `pieces`: treatment `bones`); pieces made rigid or \
+         attached to the body surface are not a fallback (docs/pieces.md).",
         percent(average(&shares).unwrap_or(0.0)),
         fallback,
         vertices,

@@ -149,8 +149,9 @@ pub struct Scored {
 pub struct SkinFacts {
     /// Stored vertices of the input as read (`counts.vertices`).
     pub vertices: usize,
-    /// `counts.fallback_weighted_vertices`: vertices no region reached, weighted from the
-    /// nearest weighted vertex or the nearest bone, plus stored vertices no triangle uses.
+    /// `counts.fallback_weighted_vertices`: vertices of decomposed pieces no region reached
+    /// (weighted from the nearest weighted vertex of their piece), of pieces bound vertex by
+    /// vertex to their nearest bone, and stored vertices no triangle uses.
     pub fallback_weighted_vertices: usize,
     /// The report's stages but writing, seconds.
     pub weights_seconds: Option<f64>,

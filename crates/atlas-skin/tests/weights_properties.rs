@@ -29,7 +29,12 @@ fn polyline(bends: &[(f64, f64)]) -> Vec<DVec3> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(24))]
+    // No failure file: a failing case is printed, and the seeds are random in every run.
+    #![proptest_config(ProptestConfig {
+        cases: 24,
+        failure_persistence: None,
+        ..ProptestConfig::default()
+    })]
 
     #[test]
     fn weights_are_a_pruned_partition_of_unity_on_any_tube(
@@ -94,9 +99,6 @@ proptest! {
             joints.sort_unstable();
             joints.dedup();
             prop_assert_eq!(joints.len(), row.len(), "joints repeat at surface vertex {}", v);
-        }
-        if loose_piece {
-            prop_assert!(skinned.counts.weights.unreachable > 0);
         }
     }
 }

@@ -6,6 +6,7 @@ use atlas_skin::fixtures::shapes::capsule_chain;
 use atlas_skin::overlap::{compute_overlaps, OverlapParams};
 use atlas_skin::pipeline::unweld_weights;
 use atlas_skin::weights::blend::Blend;
+use atlas_skin::weights::pieces::PieceTreatment;
 use atlas_skin::weights::{compute_weights, SurfaceWeights};
 use atlas_skin::{
     Boundary, BoundaryKind, Decomposition, JointDecision, JointStatus, Region, SurfaceMesh,
@@ -546,9 +547,14 @@ fn vertices_no_region_with_joints_reaches_take_the_nearest_weights() {
     )
     .expect("weights");
     assert_partition_of_unity(&weights);
-    assert_eq!(counts.from_bone, 4);
+    // The tetrahedron spans no joint: rigid to the bone it sits by; the top bar, a region
+    // of a decomposed piece, takes its weights along the piece (the fallback).
+    assert_eq!((counts.rigid, counts.from_bone, counts.attached), (4, 0, 0));
     assert!(counts.from_surface > 50, "{counts:?}");
-    assert_eq!(counts.unreachable, counts.from_bone + counts.from_surface);
+    assert_eq!(counts.unreachable, counts.rigid + counts.from_surface);
+    let treatments: Vec<PieceTreatment> = counts.pieces.iter().map(|p| p.treatment).collect();
+    assert_eq!(treatments, [PieceTreatment::Body, PieceTreatment::Rigid(0)]);
+    assert_eq!(counts.pieces[0].fallback_vertices, counts.from_surface);
     for v in base..base + 4 {
         assert_eq!(weights.row(v as usize).collect::<Vec<_>>(), vec![(0, 1.0)]);
     }

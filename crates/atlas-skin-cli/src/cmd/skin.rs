@@ -8,7 +8,9 @@ use anyhow::{anyhow, bail, Context, Result};
 use atlas_skin::pipeline::{skin, SkinInput, SkinParams, Skinned, Stage};
 use atlas_skin::report::{debug_colors, debug_lines};
 use atlas_skin::weights::blend::Blend;
-use atlas_skin::BoundaryKind;
+use atlas_skin::weights::pieces::PieceTreatment;
+use atlas_skin::weights::WeightCounts;
+use atlas_skin::{BoundaryKind, Decomposition};
 use atlas_skin_io::gltf::{debug_glb, skinned_glb, WriteOptions};
 use atlas_skin_io::{Character, OutputPlan};
 use glam::Vec3;
@@ -260,11 +262,18 @@ fn report(
     let counts = &skinned.counts;
     let mut warnings = character.warnings.clone();
     let weight_counts = &counts.weights;
-    if weight_counts.unreachable > 0 {
+    if weight_counts.from_surface > 0 {
         warnings.push(format!(
-            "{} surface vertices lie where no region with joints reaches: {} took the weights \
-             of the nearest weighted vertex along the surface, {} those of the nearest bone",
-            weight_counts.unreachable, weight_counts.from_surface, weight_counts.from_bone
+            "fallback: {} vertices of decomposed pieces lie in regions no joint reaches and took \
+             the weights of the nearest weighted vertex along their piece",
+            weight_counts.from_surface
+        ));
+    }
+    if weight_counts.from_bone > 0 {
+        warnings.push(format!(
+            "fallback: {} vertices lie in pieces that span a joint with no cut and no body \
+             beneath: each is bound to its nearest bone",
+            weight_counts.from_bone
         ));
     }
     if !weight_counts.inactive_soft_joints.is_empty() {
@@ -302,8 +311,42 @@ fn report(
             "leaf_patches": weight_counts.leaf_patches.len(),
             "far_bone_vertices": weight_counts.far_bone_vertices,
         },
+        "pieces": pieces_report(decomposition, weight_counts),
         "warnings": warnings,
     })
+}
+
+/// How the pieces were weighted: per treatment the number of pieces and vertices, and
+/// every piece that was not decomposed (`attached`, `rigid` with its joint, `bones`).
+fn pieces_report(decomposition: &Decomposition, counts: &WeightCounts) -> Value {
+    let mut summary = serde_json::Map::new();
+    let mut loose = Vec::new();
+    for piece in &counts.pieces {
+        let (name, joint) = match piece.treatment {
+            PieceTreatment::Body => ("body", None),
+            PieceTreatment::Attached => ("attached", None),
+            PieceTreatment::Rigid(j) => ("rigid", Some(j)),
+            PieceTreatment::Bones => ("bones", None),
+        };
+        let entry = summary
+            .entry(name)
+            .or_insert_with(|| json!({"pieces": 0, "vertices": 0, "fallback_vertices": 0}));
+        for (key, add) in [
+            ("pieces", 1),
+            ("vertices", piece.vertices),
+            ("fallback_vertices", piece.fallback_vertices),
+        ] {
+            entry[key] = json!(entry[key].as_u64().unwrap_or(0) + add as u64);
+        }
+        if piece.treatment != PieceTreatment::Body {
+            loose.push(json!({
+                "treatment": name,
+                "joint": joint.map(|j| decomposition.joints[j as usize].name.clone()),
+                "vertices": piece.vertices,
+            }));
+        }
+    }
+    json!({"by_treatment": summary, "not_decomposed": loose})
 }
 
 /// The debug view (a glb): the split surface coloured by region, the cut curves as lines.

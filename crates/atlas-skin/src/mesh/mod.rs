@@ -12,7 +12,7 @@ pub mod union_find;
 pub mod weld;
 pub mod winding;
 
-pub use spatial_index::FaceSpheres;
+pub use spatial_index::{FaceSpheres, NearestPoint};
 pub use surface::SurfaceMesh;
 pub use topology::{MeshStats, Topology};
 pub use weld::{weld, Welded};

@@ -8,7 +8,7 @@
 //! The decomposition asks them once per joint, never once per candidate plane.
 
 use super::surface::SurfaceMesh;
-use crate::geometry::point_triangle_distance;
+use crate::geometry::closest_point_on_triangle;
 use crate::rows::Rows;
 use crate::tolerance::RAY_PARALLEL;
 use glam::{DVec3, IVec3};
@@ -161,6 +161,29 @@ pub struct RayHit {
     pub distance: f64,
 }
 
+/// The point u a + v b + w c of face `face` (corners a, b, c) nearest to a query point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NearestPoint {
+    pub face: u32,
+    /// (u, v, w): non-negative, summing to 1.
+    pub barycentric: [f64; 3],
+    pub distance: f64,
+}
+
+impl NearestPoint {
+    /// The nearest point of face `face` of `mesh` to `p`.
+    pub fn on_face(mesh: &SurfaceMesh, face: u32, p: DVec3) -> Self {
+        let [a, b, c] = mesh.corners(face as usize);
+        let barycentric = closest_point_on_triangle(p, a, b, c);
+        let [u, v, w] = barycentric;
+        Self {
+            face,
+            barycentric,
+            distance: p.distance(a * u + b * v + c * w),
+        }
+    }
+}
+
 impl FaceSpheres {
     /// Spheres of every face of `mesh` and their grid, in O(F).
     pub fn new(mesh: &SurfaceMesh) -> Self {
@@ -188,22 +211,32 @@ impl FaceSpheres {
     }
 
     /// Distance from `p` to the nearest point of the surface, `f64::INFINITY` without faces.
+    pub fn nearest_distance(&self, mesh: &SurfaceMesh, p: DVec3) -> f64 {
+        self.nearest_point(mesh, p)
+            .map_or(f64::INFINITY, |nearest| nearest.distance)
+    }
+
+    /// The nearest point of the surface to `p` ([`NearestPoint`]: its face, barycentric
+    /// coordinates and distance; of faces at the same distance, the first met), `None`
+    /// without faces.
     ///
     /// Shells of cells around p's cell are visited outwards; |p − c_f| − r_f bounds the
     /// distance to face f from below, so a face is tested exactly only when that bound is
     /// below the best distance so far, and the search stops once every centre beyond the
     /// shell (at least shell · cell away) is too far. A point outside the grid scans all.
-    pub fn nearest_distance(&self, mesh: &SurfaceMesh, p: DVec3) -> f64 {
-        let mut best = f64::INFINITY;
-        let test = |f: u32, best: &mut f64| {
-            let f = f as usize;
-            if self.centres[f].distance(p) - self.radii[f] < *best {
-                let [a, b, c] = mesh.corners(f);
-                *best = best.min(point_triangle_distance(p, a, b, c));
+    pub fn nearest_point(&self, mesh: &SurfaceMesh, p: DVec3) -> Option<NearestPoint> {
+        let mut best: Option<NearestPoint> = None;
+        let bound = |best: &Option<NearestPoint>| best.map_or(f64::INFINITY, |b| b.distance);
+        let test = |f: u32, best: &mut Option<NearestPoint>| {
+            if self.centres[f as usize].distance(p) - self.radii[f as usize] < bound(best) {
+                let candidate = NearestPoint::on_face(mesh, f, p);
+                if candidate.distance < bound(best) {
+                    *best = Some(candidate);
+                }
             }
         };
         if self.centres.is_empty() {
-            return best;
+            return None;
         }
         if !self.grid.contains(p) {
             for f in 0..self.centres.len() as u32 {
@@ -223,7 +256,7 @@ impl FaceSpheres {
             {
                 test(f, &mut best);
             }
-            if best <= ring as f64 * self.grid.cell - self.max_radius {
+            if bound(&best) <= ring as f64 * self.grid.cell - self.max_radius {
                 break;
             }
         }
@@ -460,6 +493,7 @@ fn ray_triangle(origin: DVec3, direction: DVec3, a: DVec3, b: DVec3, c: DVec3) -
 mod tests {
     use super::*;
     use crate::fixtures::shapes::icosphere;
+    use crate::geometry::point_triangle_distance;
 
     #[test]
     fn point_triangle_distance_in_every_voronoi_region() {
@@ -658,6 +692,15 @@ mod tests {
             let p = DVec3::new(next() * 5.0 - 1.5, next() * 7.0 - 1.0, next() * 3.0 - 1.5);
             let (grid, scan) = (spheres.nearest_distance(&mesh, p), full(p));
             assert!((grid - scan).abs() < 1e-12, "{p}: {grid} vs {scan}");
+            let nearest = spheres.nearest_point(&mesh, p).expect("faces");
+            let [a, b, c] = mesh.corners(nearest.face as usize);
+            let [u, v, w] = nearest.barycentric;
+            assert!(u.min(v).min(w) >= 0.0 && (u + v + w - 1.0).abs() < 1e-12);
+            let q = a * u + b * v + c * w;
+            assert!(
+                (q.distance(p) - scan).abs() < 1e-12,
+                "{p}: {q} is not the nearest point"
+            );
             let radius = next();
             let near: Vec<u32> = (0..mesh.triangle_count() as u32)
                 .filter(|&f| {

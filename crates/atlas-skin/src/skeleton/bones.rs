@@ -73,11 +73,28 @@ pub fn nearest_bone_weights(positions: &[DVec3], skeleton: &Skeleton) -> VertexW
 /// The joint owning the bone segment nearest to `p`, argmin_j dist(p, segment_j)
 /// (`segments` from [`bone_segments`]; `None` when there is none).
 pub fn nearest_bone(segments: &[(u32, DVec3, DVec3)], p: DVec3) -> Option<u32> {
+    nearest_bone_with_distance(segments, p).map(|b| b.joint)
+}
+
+/// The nearest bone of a point: the joint owning the segment and the distance to it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NearestBone {
+    pub joint: u32,
+    pub distance: f64,
+}
+
+/// [`nearest_bone`] with the distance.
+pub fn nearest_bone_with_distance(
+    segments: &[(u32, DVec3, DVec3)],
+    p: DVec3,
+) -> Option<NearestBone> {
     segments
         .iter()
-        .map(|&(j, a, b)| (j, point_segment_distance(p, a, b)))
-        .min_by(|x, y| x.1.total_cmp(&y.1))
-        .map(|(j, _)| j)
+        .map(|&(joint, a, b)| NearestBone {
+            joint,
+            distance: point_segment_distance(p, a, b),
+        })
+        .min_by(|x, y| x.distance.total_cmp(&y.distance))
 }
 
 #[cfg(test)]

@@ -55,10 +55,12 @@
 //!    its patch ([`crate::weights::patches`]): with P = Σ_j p_j over the region's patches, every
 //!    joint of the region keeps its mass times 1 − min(1, P), and patch j receives
 //!    ω p_j / max(1, P).
-//! 4. **Fallback.** A vertex that no region with joints reaches (a loose piece, a
-//!    degenerate bit, a region without joints) copies the weights of the nearest weighted
-//!    vertex along the surface's edges (Dijkstra) when its component has one, and is bound
-//!    to the nearest bone segment otherwise ([`crate::skeleton::bones`]).
+//! 4. **Pieces.** A piece of the surface (connected component) that no region with joints
+//!    reaches is weighted as a whole by its geometry ([`crate::weights::pieces`]): attached
+//!    to the body surface it sits on (weights of the nearest body point, interpolated over
+//!    its face), rigid to one joint when it spans none, or bent at its joints by the
+//!    nearest bone. A vertex of a decomposed piece that no region reaches copies the
+//!    weights of the nearest weighted vertex along the piece's edges (the fallback).
 //! 5. **Guard.** A weight on a joint whose bones are far from the vertex, many times
 //!    farther than the nearest bone reached through the body, is removed and the row
 //!    renormalised ([`guard`]); the pipeline runs it on the result of steps 1–4.
@@ -70,10 +72,10 @@
 
 pub mod blend;
 pub mod chains;
-pub mod fallback;
 pub mod guard;
 pub mod ownership;
 pub mod patches;
+pub mod pieces;
 pub mod related;
 pub mod soft_sides;
 pub mod surface_weights;
@@ -83,8 +85,8 @@ use crate::overlap::Overlaps;
 use atlas_skin_runtime::Skeleton;
 use blend::Blend;
 use chains::{blend_vertices, region_trees};
-use fallback::fill_unweighted;
 use patches::leaf_patches;
+use pieces::weight_pieces;
 use related::{region_vertices, related_regions, vertex_bands};
 use soft_sides::soft_sides;
 use thiserror::Error;
@@ -151,7 +153,7 @@ pub fn compute_weights(
     let patches = leaf_patches(decomposition, skeleton, &active, &region_vertices);
     let trees = region_trees(decomposition, skeleton, &softs);
     let mut weights = blend_vertices(decomposition, &related, &softs, &patches, &trees, blend);
-    let mut counts = fill_unweighted(decomposition, skeleton, &mut weights);
+    let mut counts = weight_pieces(decomposition, skeleton, &mut weights);
     counts.leaf_patches = patches.iter().map(|p| p.joint).collect();
     counts.inactive_soft_joints = decomposition
         .boundaries

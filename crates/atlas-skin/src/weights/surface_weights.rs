@@ -42,10 +42,18 @@ impl SurfaceWeights {
 pub struct WeightCounts {
     /// Surface vertices no region with joints reaches.
     pub unreachable: usize,
-    /// Of those, vertices weighted from the nearest weighted vertex along the surface.
+    /// Of those, vertices of decomposed pieces weighted from the nearest weighted vertex
+    /// along their piece's edges (the fallback).
     pub from_surface: usize,
-    /// Of those, vertices bound to the nearest bone (no weighted vertex in their component).
+    /// Of those, vertices of pieces that span a joint with no body beneath, bound to their
+    /// nearest bone.
     pub from_bone: usize,
+    /// Of those, vertices of pieces attached to the body surface they sit on.
+    pub attached: usize,
+    /// Of those, vertices of pieces bound rigidly to one joint.
+    pub rigid: usize,
+    /// Every piece (connected component of the split surface) and how it was weighted.
+    pub pieces: Vec<super::pieces::PieceWeighting>,
     /// Joints whose soft boundary is inactive (no cross-section near the joint).
     pub inactive_soft_joints: Vec<u32>,
     /// Leaf joints that move a patch of skin (step 3b).
