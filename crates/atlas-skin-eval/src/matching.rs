@@ -96,7 +96,7 @@ fn loose_name(name: &str) -> String {
 /// The reference joint of every candidate joint (#K indices into the reference's #J).
 ///
 /// Three passes, each over the candidate joints still unmatched and the reference joints
-/// still free: the same name; the same [`loose_name`] when exactly one free reference
+/// still free: the same name; the same `loose_name` when exactly one free reference
 /// joint has it; then the nearest free reference joint whose bind position is within
 /// `tolerance` (ties go to the lower index). Reference joints the candidate lacks are
 /// fine (they carry no candidate weight); a candidate joint no pass matches is

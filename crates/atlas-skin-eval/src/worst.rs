@@ -49,7 +49,7 @@ pub struct Rows<'a> {
     pub candidate: &'a VertexWeights,
     /// Joint names of the reference skeleton, which both rows index.
     pub names: &'a [String],
-    /// Bone segments of the reference skeleton ([`bone_segments`]).
+    /// Bone segments of the reference skeleton ([`atlas_skin::skeleton::bones::bone_segments`]).
     pub segments: &'a [(u32, DVec3, DVec3)],
     /// Length of the mesh's bounding-box diagonal.
     pub diagonal: f64,

@@ -113,7 +113,7 @@ pub fn debug_colors(decomposition: &Decomposition) -> Vec<[f32; 4]> {
 }
 
 /// Every cut curve as line segments between consecutive loop vertices of the surface, as
-/// `[x, y, z]` pairs (for `atlas_skin_io::gltf::write_debug_glb`'s `lines`).
+/// `[x, y, z]` pairs (for `atlas_skin_io::gltf::debug_glb`'s `lines`).
 pub fn debug_lines(decomposition: &Decomposition) -> Vec<[[f32; 3]; 2]> {
     let at = |v: u32| {
         decomposition.surface.positions[v as usize]
