@@ -7,6 +7,7 @@
 
 mod accessor;
 mod animation;
+mod bindings;
 mod builder;
 mod container;
 mod debug;
@@ -19,6 +20,7 @@ mod rewrite;
 mod view_span;
 mod write;
 
+pub use bindings::Binding;
 pub use debug::write_debug_glb;
 pub use read::read;
 pub use write::{write_skinned_glb, WriteOptions};
@@ -57,6 +59,8 @@ impl std::fmt::Debug for GltfSource {
 ///
 /// - `mesh`, `primitive`: its index in `meshes` and in that mesh's `primitives`.
 /// - `node`: the node instantiating the mesh (the first one, for a skinned mesh).
+/// - `binding`: how its vertices follow the skeleton (the writer replaces the weights of
+///   skinned primitives only; rigid ones stay children of their joint node).
 /// - `position_accessor`: its POSITION accessor; primitives sharing it share `vertices`.
 /// - `vertices`: its vertices' range in `Character::mesh.positions` (all the accessor's
 ///   vertices, in accessor order).
@@ -66,6 +70,7 @@ pub struct PrimitiveSource {
     pub mesh: usize,
     pub primitive: usize,
     pub node: usize,
+    pub binding: Binding,
     pub position_accessor: usize,
     pub vertices: Range<usize>,
     pub triangles: Range<usize>,
