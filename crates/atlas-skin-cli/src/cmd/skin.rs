@@ -112,6 +112,9 @@ pub fn run(args: Args) -> Result<()> {
     write_skinned_glb(&character, &skinned.weights, &options, &args.output)?;
     timings.insert("write".into(), json!(start.elapsed().as_secs_f64() * 1e3));
     progress.finish_and_clear();
+    for warning in &skinned.warnings {
+        eprintln!("warning: {warning}");
+    }
 
     let report = report(&character, &skinned, timings);
     if let Some(path) = &args.report {
@@ -230,6 +233,7 @@ fn report(
 
     let counts = &skinned.counts;
     let mut warnings = character.warnings.clone();
+    warnings.extend(skinned.warnings.iter().cloned());
     let weight_counts = &counts.weights;
     if weight_counts.unreachable > 0 {
         warnings.push(format!(
@@ -271,6 +275,7 @@ fn report(
                 + counts.unreferenced_stored_vertices,
             "max_influences": skinned.weights.max_influences(),
             "leaf_patches": weight_counts.leaf_patches.len(),
+            "duplicate_faces": counts.duplicate_faces,
         },
         "warnings": warnings,
     })
