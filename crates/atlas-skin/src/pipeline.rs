@@ -1,5 +1,6 @@
 //! The whole method, from the mesh as stored to weights per stored vertex:
-//! weld ([`crate::mesh::weld()`], duplicate faces removed) → topology → the skeleton
+//! weld ([`crate::mesh::weld()`], duplicate faces removed) → topology (inside-out closed
+//! pieces turned outward) → the skeleton
 //! checked against the mesh ([`crate::skeleton::placement`]) and given a hierarchy when it
 //! has several roots ([`crate::skeleton::hierarchy`]) → decomposition (§3.1 cuts, §3.2 regions:
 //! [`crate::decompose()`]) → overlaps (§3.3: [`crate::overlap`]) → weights (§4, §5:
@@ -12,6 +13,7 @@
 use crate::decompose::{decompose, DecomposeError, DecomposeParams};
 use crate::decomposition::Decomposition;
 use crate::mesh::duplicate_faces::remove_duplicate_faces;
+use crate::mesh::inside_out::turn_inside_out_pieces;
 use crate::mesh::weld::DEFAULT_WELD_TOLERANCE;
 use crate::mesh::{weld, Topology, Welded};
 use crate::overlap::{compute_overlaps, OverlapError, OverlapParams, Overlaps};
@@ -140,6 +142,9 @@ pub struct SkinCounts {
     /// Triangles removed before the method because an earlier one has the same welded
     /// vertices ([`remove_duplicate_faces`]).
     pub duplicate_faces: usize,
+    /// Closed pieces wound inward, turned outward before the method
+    /// ([`turn_inside_out_pieces`]).
+    pub inside_out_pieces: usize,
 }
 
 /// Everything [`skin`] computed.
@@ -210,7 +215,14 @@ pub fn skin(
     }
 
     let done = run(Stage::Topology);
-    let topology = Topology::new(&welded.mesh);
+    let mut topology = Topology::new(&welded.mesh);
+    let inside_out = turn_inside_out_pieces(&mut welded.mesh, &topology);
+    if inside_out > 0 {
+        topology = Topology::new(&welded.mesh);
+        warnings.push(format!(
+            "{inside_out} closed piece(s) were wound inside out: turned outward for the method"
+        ));
+    }
     done(&mut timings);
 
     let done = run(Stage::Decompose);
@@ -250,6 +262,7 @@ pub fn skin(
             .len()
             .saturating_sub(welded.referenced_stored),
         duplicate_faces,
+        inside_out_pieces: inside_out,
     };
     Ok(Skinned {
         welded_of_stored: welded.welded_of_stored,

@@ -276,6 +276,7 @@ fn report(
             "max_influences": skinned.weights.max_influences(),
             "leaf_patches": weight_counts.leaf_patches.len(),
             "duplicate_faces": counts.duplicate_faces,
+            "inside_out_pieces": counts.inside_out_pieces,
         },
         "warnings": warnings,
     })
