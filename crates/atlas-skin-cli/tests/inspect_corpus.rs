@@ -91,3 +91,55 @@ fn riggedsimple() {
 fn simpleskin() {
     check(&SIMPLESKIN);
 }
+
+/// RobotExpressive (bench/robotexpressive): `inspect` counts its 4 skinned meshes on 4
+/// skins and 15 rigid meshes under joints; `skin` weights every one of its 7,214 vertices
+/// and writes a file that keeps all 19 mesh nodes and has no validator issue the input has
+/// not (the input's 4 skinned mesh nodes are not roots).
+#[test]
+fn robotexpressive_every_mesh_is_read_counted_and_kept() {
+    let input = atlas_skin_corpus::data_dir().join("bench/robotexpressive/RobotExpressive.glb");
+    let output = atlas_skin_ok(&[
+        OsString::from("inspect"),
+        "--json".into(),
+        input.clone().into(),
+    ]);
+    let report: Value = serde_json::from_slice(&output.stdout).expect("inspect prints JSON");
+    assert_eq!(
+        report["gltf_meshes"],
+        serde_json::json!({"skinned_meshes": 4, "skins": 4, "rigid_meshes": 15})
+    );
+
+    let dir = support::out_dir("inspect-robot");
+    let glb = dir.join("robot.glb");
+    let json = dir.join("robot.json");
+    atlas_skin_ok(&[
+        OsString::from("skin"),
+        input.clone().into(),
+        "-o".into(),
+        glb.clone().into(),
+        "--report".into(),
+        json.clone().into(),
+    ]);
+    let skin_report: Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(skin_report["counts"]["vertices"], 7214);
+    let written: Value = {
+        let bytes = std::fs::read(&glb).unwrap();
+        let length = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+        serde_json::from_slice(&bytes[20..20 + length]).unwrap()
+    };
+    let mesh_nodes = written["nodes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|n| n.get("mesh").is_some())
+        .count();
+    assert_eq!(mesh_nodes, 19);
+    let reports = atlas_skin_corpus::node_check("validate.mjs", &[input, glb]);
+    let codes = |r: &Value| r["codes"].as_object().unwrap().clone();
+    assert_eq!(reports[1]["errors"], 0, "{}", reports[1]);
+    for (code, count) in codes(&reports[1]) {
+        let before = reports[0]["codes"][&code].as_u64().unwrap_or(0);
+        assert!(count.as_u64().unwrap() <= before, "{code}: {}", reports[1]);
+    }
+}

@@ -1,5 +1,8 @@
 //! The whole method, from the mesh as stored to weights per stored vertex:
-//! weld ([`crate::mesh::weld()`]) → topology → decomposition (§3.1 cuts, §3.2 regions:
+//! weld ([`crate::mesh::weld()`], duplicate faces removed) → topology (inside-out closed
+//! pieces turned outward) → the skeleton
+//! checked against the mesh ([`crate::skeleton::placement`]) and given a hierarchy when it
+//! has several roots ([`crate::skeleton::hierarchy`]) → decomposition (§3.1 cuts, §3.2 regions:
 //! [`crate::decompose()`]) → overlaps (§3.3: [`crate::overlap`]) → weights (§4, §5:
 //! [`crate::weights`], then the guard against far bones, [`crate::weights::guard`]) →
 //! un-weld (weights per stored vertex, pruned to `max_influences`).
@@ -10,15 +13,19 @@
 
 use crate::decompose::{decompose, DecomposeError, DecomposeParams};
 use crate::decomposition::Decomposition;
+use crate::mesh::duplicate_faces::remove_duplicate_faces;
+use crate::mesh::inside_out::turn_inside_out_pieces;
 use crate::mesh::weld::DEFAULT_WELD_TOLERANCE;
 use crate::mesh::{weld, Topology, Welded};
 use crate::overlap::{compute_overlaps, OverlapError, OverlapParams, Overlaps};
 use crate::skeleton::bones::{bone_segments, nearest_bone};
+use crate::skeleton::hierarchy::infer_hierarchy;
+use crate::skeleton::placement::{check_placement, decomposition_warnings, PlacementError};
 use crate::weights::blend::Blend;
 use crate::weights::guard::guard_far_bones;
 use crate::weights::{compute_weights, SurfaceWeights, WeightCounts, WeightsError};
 use atlas_skin_runtime::{RuntimeError, Skeleton, VertexWeights};
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
@@ -36,6 +43,8 @@ pub enum SkinError {
     Overlap(#[from] OverlapError),
     #[error("weights failed")]
     Weights(#[from] WeightsError),
+    #[error("the skeleton does not sit in the mesh")]
+    Placement(#[from] PlacementError),
 }
 
 /// What is wrong with [`SkinParams`] or with the input as the pipeline receives it.
@@ -132,6 +141,12 @@ pub struct SkinCounts {
     pub weights: WeightCounts,
     /// Stored vertices no triangle uses, bound to their nearest bone.
     pub unreferenced_stored_vertices: usize,
+    /// Triangles removed before the method because an earlier one has the same welded
+    /// vertices ([`remove_duplicate_faces`]).
+    pub duplicate_faces: usize,
+    /// Closed pieces wound inward, turned outward before the method
+    /// ([`turn_inside_out_pieces`]).
+    pub inside_out_pieces: usize,
 }
 
 /// Everything [`skin`] computed.
@@ -147,6 +162,12 @@ pub struct Skinned {
     pub weights: VertexWeights,
     pub timings: StageTimings,
     pub counts: SkinCounts,
+    /// The skeleton the method used: the input's, or with an inferred hierarchy when the
+    /// input's had several roots (same joints, names and bind pose).
+    pub skeleton: Skeleton,
+    /// What the method noticed and handled: an inferred hierarchy, duplicate faces, joints
+    /// beside or outside the mesh, duplicate joints, zero-length bones, no boundary.
+    pub warnings: Vec<String>,
 }
 
 /// A welded surface with its topology: what every analysis of the mesh starts from.
@@ -184,31 +205,52 @@ pub fn skin(
     };
 
     let done = run(Stage::Weld);
-    let welded = weld(input.positions, input.triangles, DEFAULT_WELD_TOLERANCE);
+    let mut welded = weld(input.positions, input.triangles, DEFAULT_WELD_TOLERANCE);
+    let duplicate_faces = remove_duplicate_faces(&mut welded.mesh);
     done(&mut timings);
+    let mut warnings = Vec::new();
+    if duplicate_faces > 0 {
+        warnings.push(format!(
+            "{duplicate_faces} duplicate faces (the same three vertices as an earlier face) \
+             were left out of the method"
+        ));
+    }
 
     let done = run(Stage::Topology);
-    let topology = Topology::new(&welded.mesh);
+    let mut topology = Topology::new(&welded.mesh);
+    let inside_out = turn_inside_out_pieces(&mut welded.mesh, &topology);
+    if inside_out > 0 {
+        topology = Topology::new(&welded.mesh);
+        warnings.push(format!(
+            "{inside_out} closed piece(s) were wound inside out: turned outward for the method"
+        ));
+    }
     done(&mut timings);
 
     let done = run(Stage::Decompose);
-    let decomposition = decompose(&welded.mesh, &topology, input.skeleton, &params.decompose)?;
+    warnings.extend(check_placement(input.skeleton, &welded.mesh.positions)?);
+    let skeleton = method_skeleton(input.skeleton, &welded.mesh.positions, &mut warnings);
+    let decomposition = decompose(&welded.mesh, &topology, &skeleton, &params.decompose)?;
+    warnings.extend(decomposition_warnings(
+        &decomposition,
+        &params.decompose.forbid,
+    ));
     done(&mut timings);
 
     let done = run(Stage::Overlap);
-    let overlaps = compute_overlaps(&decomposition, input.skeleton, &params.overlap)?;
+    let overlaps = compute_overlaps(&decomposition, &skeleton, &params.overlap)?;
     done(&mut timings);
 
     let done = run(Stage::Weights);
     let (mut surface_weights, mut weight_counts) =
-        compute_weights(&decomposition, input.skeleton, &overlaps, params.blend)?;
+        compute_weights(&decomposition, &skeleton, &overlaps, params.blend)?;
     weight_counts.far_bone_vertices =
-        guard_far_bones(&decomposition, input.skeleton, &mut surface_weights);
+        guard_far_bones(&decomposition, &skeleton, &mut surface_weights);
     let weights = unweld_weights(
         &surface_weights,
         &welded.welded_of_stored,
         input.positions,
-        input.skeleton,
+        &skeleton,
         params.max_influences,
     );
     done(&mut timings);
@@ -223,6 +265,8 @@ pub fn skin(
             .positions
             .len()
             .saturating_sub(welded.referenced_stored),
+        duplicate_faces,
+        inside_out_pieces: inside_out,
     };
     Ok(Skinned {
         welded_of_stored: welded.welded_of_stored,
@@ -232,7 +276,31 @@ pub fn skin(
         weights,
         timings,
         counts,
+        skeleton,
+        warnings,
     })
+}
+
+/// The skeleton the method runs on: `skeleton` itself, or a copy with the hierarchy
+/// [`infer_hierarchy`] gives when it has several roots (its warning added to `warnings`).
+fn method_skeleton(
+    skeleton: &Skeleton,
+    vertices: &[DVec3],
+    warnings: &mut Vec<String>,
+) -> Skeleton {
+    let centroid = vertices.iter().sum::<DVec3>() / vertices.len().max(1) as f64;
+    let Some(inferred) = infer_hierarchy(skeleton, centroid) else {
+        return skeleton.clone();
+    };
+    let had_links = skeleton
+        .parents
+        .iter()
+        .any(|&p| p != atlas_skin_runtime::NO_PARENT);
+    warnings.push(inferred.warning(skeleton, had_links));
+    Skeleton {
+        parents: inferred.parents,
+        ..skeleton.clone()
+    }
 }
 
 /// Checks the settings and the input once, and returns the settings the stages run with:

@@ -4,9 +4,11 @@
 use crate::input::{InputArgs, Prepared};
 use anyhow::Result;
 use atlas_skin::mesh::winding::is_inside;
+use atlas_skin_io::gltf::{Binding, PrimitiveSource};
 use atlas_skin_io::PartBinding;
 use rayon::prelude::*;
 use serde::Serialize;
+use std::collections::BTreeSet;
 
 /// Arguments.
 #[derive(clap::Args)]
@@ -57,6 +59,8 @@ pub struct Report {
     pub nonmanifold_edges: usize,
     pub inconsistently_oriented_edges: usize,
     pub joints: Vec<JointReport>,
+    /// For glTF input with a skin: the meshes read.
+    pub gltf_meshes: Option<GltfMeshes>,
     /// Whether the input came with weights (artist or precomputed).
     pub reference_weights: bool,
     pub clips: Vec<ClipReport>,
@@ -85,6 +89,37 @@ pub struct PartReport {
     pub vertices: usize,
     pub triangles: usize,
     pub binding: String,
+}
+
+/// The meshes of a skinned glTF read into the character: skinned meshes, the skins they
+/// use (all over the same joints), rigid meshes under joint nodes (one per node).
+#[derive(Debug, Serialize, PartialEq, Eq)]
+pub struct GltfMeshes {
+    pub skinned_meshes: usize,
+    pub skins: usize,
+    pub rigid_meshes: usize,
+}
+
+impl GltfMeshes {
+    fn of(source: &atlas_skin_io::gltf::GltfSource) -> Option<Self> {
+        source.skin?;
+        let distinct = |key: &dyn Fn(&PrimitiveSource) -> Option<usize>| {
+            source
+                .primitives
+                .iter()
+                .filter_map(key)
+                .collect::<BTreeSet<_>>()
+                .len()
+        };
+        Some(Self {
+            skinned_meshes: distinct(&|p| matches!(p.binding, Binding::Skin(_)).then_some(p.mesh)),
+            skins: distinct(&|p| match p.binding {
+                Binding::Skin(skin) => Some(skin),
+                _ => None,
+            }),
+            rigid_meshes: distinct(&|p| matches!(p.binding, Binding::Rigid(_)).then_some(p.node)),
+        })
+    }
 }
 
 #[derive(Debug, Serialize)]
@@ -154,6 +189,7 @@ impl Report {
             nonmanifold_edges: stats.nonmanifold_edges,
             inconsistently_oriented_edges: stats.inconsistently_oriented_edges,
             joints,
+            gltf_meshes: character.gltf.as_ref().and_then(GltfMeshes::of),
             reference_weights: character.reference_weights.is_some(),
             clips: character
                 .clips
@@ -216,6 +252,16 @@ impl Report {
                 self.joints.len()
             ),
         ]);
+        if let Some(m) = &self.gltf_meshes {
+            let at = lines.len() - 1;
+            lines.insert(
+                at,
+                format!(
+                    "glTF meshes:           {} skinned on {} skin(s), {} rigid under joints",
+                    m.skinned_meshes, m.skins, m.rigid_meshes
+                ),
+            );
+        }
         for (depth, joint) in self.joint_tree() {
             let [x, y, z] = joint.position;
             let flag = if joint.inside { "inside " } else { "OUTSIDE" };

@@ -138,6 +138,9 @@ pub fn run(args: Args) -> Result<()> {
         (path, text)
     });
     progress.finish_and_clear();
+    for warning in &skinned.warnings {
+        eprintln!("warning: {warning}");
+    }
 
     let report = report(&character, &skinned, timings);
     if let Some(path) = &args.report {
@@ -261,6 +264,7 @@ fn report(
 
     let counts = &skinned.counts;
     let mut warnings = character.warnings.clone();
+    warnings.extend(skinned.warnings.iter().cloned());
     let weight_counts = &counts.weights;
     if weight_counts.from_surface > 0 {
         warnings.push(format!(
@@ -310,6 +314,8 @@ fn report(
             "max_influences": skinned.weights.max_influences(),
             "leaf_patches": weight_counts.leaf_patches.len(),
             "far_bone_vertices": weight_counts.far_bone_vertices,
+            "duplicate_faces": counts.duplicate_faces,
+            "inside_out_pieces": counts.inside_out_pieces,
         },
         "pieces": pieces_report(decomposition, weight_counts),
         "warnings": warnings,

@@ -7,6 +7,7 @@
 
 mod accessor;
 mod animation;
+mod bindings;
 mod budget;
 mod builder;
 mod container;
@@ -21,6 +22,7 @@ mod rewrite;
 mod view_span;
 mod write;
 
+pub use bindings::Binding;
 pub use budget::{DECODED_FLOOR_BYTES, DECODED_PER_INPUT_BYTE, MAX_DECODED_BYTES};
 pub use container::{ImageBytes, MAX_LOADED_BYTES};
 pub use debug::debug_glb;
@@ -67,6 +69,8 @@ impl std::fmt::Debug for GltfSource {
 ///
 /// - `mesh`, `primitive`: its index in `meshes` and in that mesh's `primitives`.
 /// - `node`: the node instantiating the mesh (the first one, for a skinned mesh).
+/// - `binding`: how its vertices follow the skeleton (the writer replaces the weights of
+///   skinned primitives only; rigid ones stay children of their joint node).
 /// - `position_accessor`: its POSITION accessor; primitives sharing it share `vertices`.
 /// - `vertices`: its vertices' range in `Character::mesh.positions` (all the accessor's
 ///   vertices, in accessor order).
@@ -76,6 +80,7 @@ pub struct PrimitiveSource {
     pub mesh: usize,
     pub primitive: usize,
     pub node: usize,
+    pub binding: Binding,
     pub position_accessor: usize,
     pub vertices: Range<usize>,
     pub triangles: Range<usize>,

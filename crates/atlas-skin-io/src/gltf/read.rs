@@ -3,6 +3,7 @@
 
 use super::accessor::{read_floats, read_uints};
 use super::animation::{read_clips, read_rig};
+use super::bindings::{inverse_binds, mesh_instances, skin_joints, Binding, MeshInstance};
 use super::budget::DecodeBudget;
 use super::container::read_container;
 use super::document::Document;
@@ -17,16 +18,19 @@ use std::path::Path;
 
 /// Reads a `.glb`, `.gltf` (embedded or external buffers) or `.vrm` file.
 ///
-/// - Skin: the first skin used by a node that also has a mesh. Its meshes' triangle
-///   primitives (TRIANGLES, or strips and fans converted) are concatenated in document
-///   order, positions as stored (the skin's bind space; node transforms are not applied).
+/// - Skin: the first skin used by a node that also has a mesh. The meshes of every skin
+///   over the same joints, then the rigid meshes under a joint node (see
+///   [`mesh_instances`]): their triangle primitives (TRIANGLES, or strips and fans
+///   converted) are concatenated, positions in the first skin's bind space (stored
+///   positions for its own meshes; node transforms of skinned meshes are not applied).
 ///   Without a skin, every mesh node's triangles are read with the node's world transform
 ///   applied, and the character has no skeleton.
 /// - Primitives sharing a POSITION accessor share their vertices in `Character::mesh`.
 /// - Skeleton: the skin's joints in skin order, each joint's parent the nearest ancestor
 ///   node that is a joint; names from the nodes (`node<index>` when missing, made unique);
 ///   bind pose from `inverseBindMatrices` (identity when absent).
-/// - Reference weights: JOINTS_n/WEIGHTS_n as stored (not renormalised, zeros dropped).
+/// - Reference weights: JOINTS_n/WEIGHTS_n as stored (not renormalised, zeros dropped),
+///   weight 1 on their joint for rigid meshes.
 ///
 /// # Errors
 /// [`IoError`] naming the file and the problem for anything malformed: containers,
@@ -43,14 +47,35 @@ pub fn read(path: &Path) -> Result<Character, IoError> {
     reject_compressed_geometry(&doc)?;
     let tree = NodeTree::new(&doc)?;
     let skin = find_skin(&doc)?;
-    let joints = match skin {
-        Some(skin) => skin_joints(&doc, skin)?,
-        None => Vec::new(),
+    let mut warnings = std::mem::take(&mut container.warnings);
+    let (joints, binds, cleaned) = match skin {
+        Some(skin) => {
+            let joints = skin_joints(&doc, skin)?;
+            let mut binds = inverse_binds(&doc, skin, joints.len())?;
+            let cleaned: Vec<usize> = binds
+                .iter_mut()
+                .enumerate()
+                .filter_map(|(joint, matrix)| {
+                    let affine = affine_inverse_bind(*matrix)?;
+                    *matrix = affine;
+                    Some(joint)
+                })
+                .collect();
+            if let Some(&first) = cleaned.first() {
+                warnings.push(format!(
+                    "skins[{skin}].inverseBindMatrices: {} matrices (first: joint {first}) are \
+                     projective (last row not (0, 0, 0, 1)); made affine, and written so",
+                    cleaned.len()
+                ));
+            }
+            (joints, binds, cleaned)
+        }
+        None => (Vec::new(), Vec::new(), Vec::new()),
     };
     let names = unique_node_names(&doc, &joints)?;
-    let mut warnings = std::mem::take(&mut container.warnings);
-    let instances = mesh_instances(&doc, &tree, skin)?;
-    let geometry = read_geometry(&doc, &instances, &mut warnings)?;
+    let instances = mesh_instances(&doc, &tree, skin.map(|s| (s, &joints[..], &binds[..])))?;
+    warnings.extend(instances.warnings);
+    let geometry = read_geometry(&doc, &instances.list, &mut warnings)?;
     if geometry.mesh.triangles.is_empty() {
         return Err(doc.error(if skin.is_some() {
             "the skinned meshes have no triangle primitive"
@@ -60,12 +85,11 @@ pub fn read(path: &Path) -> Result<Character, IoError> {
     }
     let mut inverse_binds_cleaned = false;
     let (skeleton, reference_weights) = match skin {
-        Some(skin) => {
+        Some(_) => {
             let joint_names = joints.iter().map(|&n| names[n].clone()).collect();
-            let (skeleton, cleaned) =
-                read_skeleton(&doc, &tree, skin, &joints, joint_names, &mut warnings)?;
-            inverse_binds_cleaned = cleaned;
-            let weights = read_reference_weights(&doc, &geometry.blocks, joints.len())?;
+            let skeleton = read_skeleton(&doc, &tree, &joints, binds, joint_names)?;
+            let weights = read_reference_weights(&doc, &geometry.blocks, &joints)?;
+            inverse_binds_cleaned = !cleaned.is_empty();
             (Some(skeleton), weights)
         }
         None => (None, None),
@@ -125,92 +149,16 @@ fn find_skin(doc: &Document) -> Result<Option<usize>, IoError> {
     Ok(None)
 }
 
-/// The joint node indices of `skin`: non-empty, in range, no node twice.
-fn skin_joints(doc: &Document, skin: usize) -> Result<Vec<usize>, IoError> {
-    let location = format!("skins[{skin}]");
-    let joints = doc.indices(doc.item("skins", skin)?, &location, "joints")?;
-    let node_count = doc.array("nodes")?.len();
-    if joints.is_empty() {
-        return Err(doc.error(format!("{location} has no joints")));
-    }
-    let mut seen = vec![false; node_count];
-    for &node in &joints {
-        if node >= node_count {
-            return Err(doc.error(format!(
-                "{location}.joints has node {node}, but the document has {node_count} nodes"
-            )));
-        }
-        if std::mem::replace(&mut seen[node], true) {
-            return Err(doc.error(format!("{location}.joints lists node {node} twice")));
-        }
-    }
-    Ok(joints)
-}
-
-/// One use of a mesh by a node; `world` is applied to positions (unskinned input only).
-struct MeshInstance {
-    node: usize,
-    mesh: usize,
-    world: Option<Mat4>,
-}
-
-/// With a skin: each mesh used by a node with that skin, once, untransformed. Without:
-/// every mesh node with its world transform.
-fn mesh_instances(
-    doc: &Document,
-    tree: &NodeTree,
-    skin: Option<usize>,
-) -> Result<Vec<MeshInstance>, IoError> {
-    let mesh_count = doc.array("meshes")?.len();
-    let worlds = if skin.is_none() {
-        tree.worlds()
-    } else {
-        Vec::new()
-    };
-    let mut instances: Vec<MeshInstance> = Vec::new();
-    for (node, object) in doc.array("nodes")?.iter().enumerate() {
-        let location = format!("nodes[{node}]");
-        let Some(mesh) = doc.opt_index(object, &location, "mesh")? else {
-            continue;
-        };
-        if mesh >= mesh_count {
-            return Err(doc.error(format!(
-                "{location}.mesh is {mesh} but the document has {mesh_count} meshes"
-            )));
-        }
-        match skin {
-            Some(skin) => {
-                let uses_skin = doc.opt_index(object, &location, "skin")? == Some(skin);
-                if uses_skin && !instances.iter().any(|i| i.mesh == mesh) {
-                    instances.push(MeshInstance {
-                        node,
-                        mesh,
-                        world: None,
-                    });
-                }
-            }
-            None => instances.push(MeshInstance {
-                node,
-                mesh,
-                world: worlds.get(node).copied(),
-            }),
-        }
-    }
-    if skin.is_some() {
-        // Document order of the meshes, not of the nodes using them.
-        instances.sort_by_key(|i| i.mesh);
-    }
-    Ok(instances)
-}
-
 /// Vertices of one POSITION accessor (per node when a world transform was applied), shared
 /// by the primitives that use it.
 ///
 /// - `attributes`: the `attributes` object of the first primitive using them (where the
 ///   stored weights are read).
+/// - `binding`: how they follow the skeleton.
 /// - `first`, `count`: their range in the concatenated mesh.
 struct VertexBlock<'a> {
     attributes: &'a Value,
+    binding: Binding,
     location: String,
     first: usize,
     count: usize,
@@ -258,14 +206,15 @@ fn read_geometry<'a>(
                 .filter(|a| a.is_object())
                 .ok_or_else(|| doc.error(format!("{location} has no attributes object")))?;
             let position = doc.index(attributes, &format!("{location}.attributes"), "POSITION")?;
-            let key = (position, instance.world.map(|_| instance.node));
+            let key = (position, instance.to_bind.map(|_| instance.node));
             let block = match block_of.get(&key) {
                 Some(&block) => block,
                 None => {
                     let first = mesh.positions.len();
-                    let positions = read_positions(doc, position, &location, instance.world)?;
+                    let positions = read_positions(doc, position, &location, instance.to_bind)?;
                     blocks.push(VertexBlock {
                         attributes,
+                        binding: instance.binding,
                         location: location.clone(),
                         first,
                         count: positions.len(),
@@ -302,6 +251,7 @@ fn read_geometry<'a>(
             primitives.push(PrimitiveSource {
                 node: instance.node,
                 mesh: instance.mesh,
+                binding: instance.binding,
                 primitive: index,
                 position_accessor: position,
                 vertices: first..first + vertex_count,
@@ -316,7 +266,8 @@ fn read_geometry<'a>(
     })
 }
 
-/// Positions of accessor `position` (VEC3), transformed by `world` when given; every
+/// Positions of accessor `position` (VEC3), transformed by `world` (the instance's
+/// transform to the bind space or to the world) when given; every
 /// coordinate must be finite, as stored and after the transform. Errors show the stored
 /// values (a transform would spread one NaN over all three coordinates).
 fn read_positions(
@@ -400,49 +351,14 @@ fn affine_inverse_bind(m: Mat4) -> Option<Mat4> {
     Some(Mat4::from_cols_array_2d(&columns))
 }
 
-/// The skeleton of `skin` over its `joints` (node indices), and whether projective inverse
-/// bind matrices were made affine ([`affine_inverse_bind`], with a warning).
+/// The skeleton over the skin's `joints` (node indices) with their inverse bind matrices.
 fn read_skeleton(
     doc: &Document,
     tree: &NodeTree,
-    skin: usize,
     joints: &[usize],
+    inverse_bind: Vec<Mat4>,
     names: Vec<String>,
-    warnings: &mut Vec<String>,
-) -> Result<(Skeleton, bool), IoError> {
-    let location = format!("skins[{skin}]");
-    let object = doc.item("skins", skin)?;
-    let mut cleaned = Vec::new();
-    let inverse_bind = match doc.opt_index(object, &location, "inverseBindMatrices")? {
-        None => vec![Mat4::IDENTITY; joints.len()],
-        Some(accessor) => {
-            let role = format!("{location}.inverseBindMatrices");
-            let values = read_floats(doc, accessor, "MAT4", &role)?;
-            if values.len() / 16 != joints.len() {
-                return Err(doc.error(format!(
-                    "{location}.inverseBindMatrices has {} matrices for {} joints",
-                    values.len() / 16,
-                    joints.len()
-                )));
-            }
-            let mut matrices: Vec<Mat4> =
-                values.chunks_exact(16).map(Mat4::from_cols_slice).collect();
-            for (joint, matrix) in matrices.iter_mut().enumerate() {
-                if let Some(affine) = affine_inverse_bind(*matrix) {
-                    cleaned.push(joint);
-                    *matrix = affine;
-                }
-            }
-            if let Some(&first) = cleaned.first() {
-                warnings.push(format!(
-                    "{role}: {} matrices (first: joint {first}) are projective (last row not \
-                     (0, 0, 0, 1)); made affine, and written so",
-                    cleaned.len()
-                ));
-            }
-            matrices
-        }
-    };
+) -> Result<Skeleton, IoError> {
     let joint_of: HashMap<usize, u32> = joints
         .iter()
         .enumerate()
@@ -466,19 +382,37 @@ fn read_skeleton(
             path: doc.path.to_path_buf(),
             cause,
         })?;
-    Ok((skeleton, !cleaned.is_empty()))
+    Ok(skeleton)
 }
 
-/// The stored JOINTS_n/WEIGHTS_n of every vertex block, as stored (zeros dropped); `None`
-/// when no block has JOINTS_0. Blocks without weights get empty rows.
+/// The stored JOINTS_n/WEIGHTS_n of every vertex block, as stored (zeros dropped), joint
+/// indices mapped from the block's skin to the skeleton (`skeleton_nodes`: the skeleton's
+/// joint nodes); `None` when no block has JOINTS_0. Blocks without weights get empty rows;
+/// rigid blocks weight 1 on their joint.
 fn read_reference_weights(
     doc: &Document,
     blocks: &[VertexBlock],
-    joint_count: usize,
+    skeleton_nodes: &[usize],
 ) -> Result<Option<VertexWeights>, IoError> {
     let mut rows: Vec<Vec<(u32, f32)>> = Vec::new();
     let mut any = false;
     for block in blocks {
+        let skin = match block.binding {
+            Binding::Skin(skin) => skin,
+            Binding::Rigid(joint) => {
+                rows.extend(vec![vec![(joint, 1.0)]; block.count]);
+                continue;
+            }
+            Binding::Unskinned => {
+                rows.extend(vec![Vec::new(); block.count]);
+                continue;
+            }
+        };
+        let skeleton_joint: Vec<u32> = skin_joints(doc, skin)?
+            .iter()
+            .map(|node| skeleton_nodes.iter().position(|n| n == node).unwrap_or(0) as u32)
+            .collect();
+        let joint_count = skeleton_joint.len();
         let mut block_rows = vec![Vec::new(); block.count];
         for set in 0.. {
             let location = format!("{}.attributes", block.location);
@@ -521,7 +455,7 @@ fn read_reference_weights(
                              has {joint_count} joints"
                         )));
                     }
-                    row.push((joint, weight));
+                    row.push((skeleton_joint[joint as usize], weight));
                 }
             }
         }

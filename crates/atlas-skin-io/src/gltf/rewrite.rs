@@ -6,20 +6,22 @@ use super::prune::{drop_orphans, References};
 use super::write::{
     merge_asset_extras, pack_weights, push_inverse_binds, push_weight_accessors, WriteOptions,
 };
-use super::GltfSource;
+use super::{Binding, GltfSource};
 use crate::{Character, IoError};
 use atlas_skin_runtime::VertexWeights;
 use serde_json::{json, Map, Value};
 use std::collections::{BTreeMap, BTreeSet};
+use std::ops::Range;
 use std::path::Path;
 
 /// The `.glb` bytes of the input document with new weights.
 ///
 /// Every bufferView is copied into the single output buffer (its offset keeps its phase
 /// modulo 4, so accessors inside stay aligned); images with a URI are embedded as
-/// bufferViews. For each POSITION accessor read into `character.mesh`, new JOINTS_n and
-/// WEIGHTS_n accessors are made once and put on every primitive of the skinned meshes
-/// using that POSITION accessor; JOINTS_n/WEIGHTS_n sets beyond the new ones are removed.
+/// bufferViews. For each POSITION accessor of a skinned mesh read into `character.mesh`,
+/// new JOINTS_n and WEIGHTS_n accessors (joint indices in the order of that mesh's skin)
+/// are made once and put on every primitive of the skinned meshes using that POSITION
+/// accessor (rigid meshes under joint nodes stay as they are); JOINTS_n/WEIGHTS_n sets beyond the new ones are removed.
 /// The accessors, bufferViews and bytes only the old weights used are then dropped, and a
 /// view they shared with other data is cut to what that data reads (see
 /// [`drop_orphans`]); what the input itself left unreferenced stays.
@@ -55,16 +57,36 @@ pub(crate) fn rewrite_document(
             ),
         ));
     }
-    let mut new_sets: BTreeMap<usize, Vec<(usize, usize)>> = BTreeMap::new();
+    // New accessors per block of vertices read (a POSITION accessor in one bind space),
+    // and the accessors of every (skinned mesh, POSITION accessor).
+    let mut block_sets: BTreeMap<usize, Vec<(usize, usize)>> = BTreeMap::new();
+    let mut new_sets: BTreeMap<(usize, usize), Vec<(usize, usize)>> = BTreeMap::new();
     for primitive in &source.primitives {
-        if new_sets.contains_key(&primitive.position_accessor) {
+        let Binding::Skin(skin) = primitive.binding else {
             continue;
+        };
+        let first = primitive.vertices.start;
+        if let std::collections::btree_map::Entry::Vacant(entry) = block_sets.entry(first) {
+            let skin_weights = in_skin_order(
+                weights,
+                primitive.vertices.clone(),
+                &joint_nodes,
+                &skin_joint_nodes(&source.document, Some(skin), input)?,
+            );
+            let packed = pack_weights(
+                &skin_weights,
+                0..primitive.vertices.len(),
+                options.max_influences,
+            );
+            let accessors = push_weight_accessors(&mut builder, &packed, joint_count);
+            entry.insert(accessors);
         }
-        let packed = pack_weights(weights, primitive.vertices.clone(), options.max_influences);
-        let accessors = push_weight_accessors(&mut builder, &packed, joint_count);
-        new_sets.insert(primitive.position_accessor, accessors);
+        new_sets.insert(
+            (primitive.mesh, primitive.position_accessor),
+            block_sets[&first].clone(),
+        );
     }
-    replace_weight_attributes(builder.json_mut(), &skinned_meshes, &new_sets);
+    replace_weight_attributes(builder.json_mut(), &new_sets);
     set_position_bounds(builder.json_mut(), character, source);
     if let (true, Some(skeleton), Some(skin)) = (
         source.inverse_binds_cleaned,
@@ -308,17 +330,17 @@ fn sniff_image_type(bytes: &[u8]) -> Option<&'static str> {
     }
 }
 
-/// On every primitive of `meshes` whose POSITION accessor has new weights: JOINTS_k and
+/// On every primitive whose (mesh, POSITION accessor) has new weights: JOINTS_k and
 /// WEIGHTS_k set to the new accessors, and sets beyond them removed.
 fn replace_weight_attributes(
     json: &mut Map<String, Value>,
-    meshes: &BTreeSet<usize>,
-    new_sets: &BTreeMap<usize, Vec<(usize, usize)>>,
+    new_sets: &BTreeMap<(usize, usize), Vec<(usize, usize)>>,
 ) {
     let Some(Value::Array(all_meshes)) = json.get_mut("meshes") else {
         return;
     };
-    for &mesh in meshes {
+    let meshes: BTreeSet<usize> = new_sets.keys().map(|&(mesh, _)| mesh).collect();
+    for mesh in meshes {
         let Some(Value::Array(primitives)) = all_meshes
             .get_mut(mesh)
             .and_then(|m| m.get_mut("primitives"))
@@ -330,7 +352,7 @@ fn replace_weight_attributes(
                 continue;
             };
             let position = attributes.get("POSITION").and_then(Value::as_u64);
-            let Some(sets) = position.and_then(|p| new_sets.get(&(p as usize))) else {
+            let Some(sets) = position.and_then(|p| new_sets.get(&(mesh, p as usize))) else {
                 continue;
             };
             attributes.retain(|name, _| {
@@ -346,6 +368,26 @@ fn replace_weight_attributes(
             }
         }
     }
+}
+
+/// Rows `vertices` of `weights` (joint indices into the skeleton, whose joint nodes are
+/// `skeleton_nodes`) with joint indices into a skin over the same nodes `skin_nodes`.
+fn in_skin_order(
+    weights: &VertexWeights,
+    vertices: Range<usize>,
+    skeleton_nodes: &[usize],
+    skin_nodes: &[usize],
+) -> VertexWeights {
+    let index_in_skin: Vec<u32> = skeleton_nodes
+        .iter()
+        .map(|node| skin_nodes.iter().position(|n| n == node).unwrap_or(0) as u32)
+        .collect();
+    VertexWeights::from_rows(vertices.map(|v| {
+        weights
+            .row(v)
+            .map(|(j, w)| (index_in_skin[j as usize], w))
+            .collect::<Vec<_>>()
+    }))
 }
 
 /// Node index of every joint of `skin`.

@@ -1,6 +1,10 @@
 //! What the method reads from the skeleton beyond the runtime's [`Skeleton`]
-//! (`atlas_skin_runtime`): bone segments and nearest bones ([`bones`]).
+//! (`atlas_skin_runtime`): bone segments and nearest bones ([`bones`]), a hierarchy for
+//! skeletons with several roots ([`hierarchy`]), whether the skeleton sits in the mesh
+//! ([`placement`]).
 //!
 //! [`Skeleton`]: atlas_skin_runtime::Skeleton
 
 pub mod bones;
+pub mod hierarchy;
+pub mod placement;
