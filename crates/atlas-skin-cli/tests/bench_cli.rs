@@ -27,23 +27,15 @@ fn bench_json(threads: &str) -> Value {
     serde_json::from_str(&text).expect("one JSON object")
 }
 
-/// The JSON report has every figure the issue names, for the requested size and threads,
-/// and a frame allocates nothing. On one thread the count is exact. On two, rayon's work
-/// stealing may allocate on its own once in a while (a worker's first steal registers it
-/// with crossbeam's epoch collector), which no frame of ours causes: an allocation made by
-/// every frame would count at least 1 per frame.
+/// The JSON report has every figure the issue names, for the requested size and threads.
+/// (That a frame allocates nothing is the runtime's `tests/no_allocation.rs`.)
 #[test]
 fn bench_runs_on_the_demo_character() {
     let single = bench_json("1");
     assert_eq!(single["threads"], 1, "{single}");
-    assert_eq!(single["allocations_per_frame"], 0.0, "{single}");
     let report = bench_json("2");
     assert_eq!(report["vertices"], 20_000, "{report}");
     assert_eq!(report["threads"], 2, "{report}");
-    let allocations = report["allocations_per_frame"]
-        .as_f64()
-        .expect("allocations");
-    assert!(allocations < 1.0, "{report}");
     let influences = report["influences"].as_u64().expect("influences");
     assert!((1..=4).contains(&influences), "{report}");
     for key in [
@@ -125,7 +117,6 @@ fn bench_writes_side_by_side_data() {
     let report: Value = serde_json::from_str(&text).expect("one JSON object");
     assert_eq!(report["batch"], 3, "{report}");
     assert_eq!(report["instruction_set"], "portable", "{report}");
-    assert_eq!(report["allocations_per_frame"], 0.0, "{report}");
     let bytes = std::fs::read(&data).expect("data file written");
     let int = |at: usize| i32::from_le_bytes(bytes[at..at + 4].try_into().expect("4 bytes"));
     let (vertices, joints) = (int(0) as usize, int(4) as usize);

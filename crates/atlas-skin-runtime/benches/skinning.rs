@@ -15,6 +15,10 @@ use glam::{Mat4, Vec3};
 const JOINTS: usize = 64;
 const SIZES: [usize; 4] = [1_000, 15_000, 100_000, 1_000_000];
 
+// This bench binary alone counts allocations: divan reports them per iteration.
+#[global_allocator]
+static ALLOC: divan::AllocProfiler = divan::AllocProfiler::system();
+
 fn main() {
     divan::main();
 }

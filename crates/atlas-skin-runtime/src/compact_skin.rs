@@ -134,19 +134,37 @@ mod tests {
 
     #[test]
     fn invalid_weights_are_rejected() {
-        let cases = [
-            (VertexWeights::from_rows([vec![(5, 1.0)]]), 2),
-            (VertexWeights::from_rows([vec![(0, -1.0)]]), 2),
-            (VertexWeights::from_rows([vec![(0, f32::NAN)]]), 2),
-            (VertexWeights::from_rows([vec![(0, 1.0)], vec![]]), 2),
-            (VertexWeights::from_rows([vec![(0, 0.0)]]), 2),
-            (VertexWeights::from_rows([vec![(0, 1.0)]]), 70_000),
+        use RuntimeError::*;
+        // Each case breaks one rule and is refused for that rule.
+        type Case = (VertexWeights, usize, fn(&RuntimeError) -> bool);
+        let cases: [Case; 6] = [
+            (VertexWeights::from_rows([vec![(5, 1.0)]]), 2, |e| {
+                matches!(e, JointOutOfRange { .. })
+            }),
+            (VertexWeights::from_rows([vec![(0, -1.0)]]), 2, |e| {
+                matches!(e, BadWeight { vertex: 0, .. })
+            }),
+            (VertexWeights::from_rows([vec![(0, f32::NAN)]]), 2, |e| {
+                matches!(e, BadWeight { vertex: 0, .. })
+            }),
+            (VertexWeights::from_rows([vec![(0, 1.0)], vec![]]), 2, |e| {
+                matches!(e, UnweightedVertex { vertex: 1 })
+            }),
+            (VertexWeights::from_rows([vec![(0, 0.0)]]), 2, |e| {
+                matches!(e, UnweightedVertex { vertex: 0 })
+            }),
+            (VertexWeights::from_rows([vec![(0, 1.0)]]), 70_000, |e| {
+                matches!(e, TooManyJoints { count: 70_000 })
+            }),
         ];
-        for (weights, joints) in cases {
-            assert!(
-                CompactSkin::new(&weights, joints, 4).is_err(),
-                "accepted {weights:?}"
-            );
+        for (weights, joints, expected) in cases {
+            match CompactSkin::new(&weights, joints, 4) {
+                Err(e) => assert!(
+                    expected(&e),
+                    "{weights:?}: refused for another reason: {e:?}"
+                ),
+                Ok(_) => panic!("accepted {weights:?}"),
+            }
         }
     }
 

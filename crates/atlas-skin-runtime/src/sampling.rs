@@ -181,24 +181,48 @@ mod tests {
     fn invalid_clips_are_rejected() {
         use Interpolation::*;
         use Property::*;
+        // Each case breaks one rule of a track and is refused for that rule (`what`).
         let cases = [
-            track(Translation, Linear, &[], &[]),
-            track(Translation, Linear, &[0.0, 0.0], &[0.0; 6]),
-            track(Translation, Linear, &[0.0, 1.0], &[0.0; 5]),
-            track(Translation, CubicSpline, &[0.0, 1.0], &[0.0; 6]),
-            track(Translation, Step, &[0.0], &[f32::NAN, 0.0, 0.0]),
-            track(Rotation, Linear, &[0.0], &[0.0; 4]),
-            track(Scale, Linear, &[f32::INFINITY], &[1.0; 3]),
-            Track {
-                node: 3,
-                ..track(Scale, Linear, &[0.0], &[1.0; 3])
-            },
+            (track(Translation, Linear, &[], &[]), "no keys"),
+            (
+                track(Translation, Linear, &[0.0, 0.0], &[0.0; 6]),
+                "strictly increasing",
+            ),
+            (
+                track(Translation, Linear, &[0.0, 1.0], &[0.0; 5]),
+                "5 values for 2 keys",
+            ),
+            (
+                track(Translation, CubicSpline, &[0.0, 1.0], &[0.0; 6]),
+                "expected 18",
+            ),
+            (
+                track(Translation, Step, &[0.0], &[f32::NAN, 0.0, 0.0]),
+                "non-finite value",
+            ),
+            (
+                track(Rotation, Linear, &[0.0], &[0.0; 4]),
+                "zero rotation quaternion",
+            ),
+            (
+                track(Scale, Linear, &[f32::INFINITY], &[1.0; 3]),
+                "strictly increasing",
+            ),
+            (
+                Track {
+                    node: 3,
+                    ..track(Scale, Linear, &[0.0], &[1.0; 3])
+                },
+                "the rig has 1 nodes",
+            ),
         ];
-        for case in cases {
-            assert!(
-                clip(vec![case.clone()]).validate(1).is_err(),
-                "accepted {case:?}"
-            );
+        for (case, reason) in cases {
+            match clip(vec![case.clone()]).validate(1) {
+                Err(RuntimeError::BadTrack { what, .. }) => {
+                    assert!(what.contains(reason), "{case:?}: {what}")
+                }
+                other => panic!("{case:?}: expected a bad track ({reason}), got {other:?}"),
+            }
         }
         let ok = track(Translation, CubicSpline, &[0.0, 1.0], &[0.0; 18]);
         assert!(clip(vec![ok]).validate(1).is_ok());

@@ -217,24 +217,35 @@ mod tests {
     fn invalid_skeletons_are_rejected() {
         let names = || vec!["a".to_string(), "b".to_string()];
         let ibm = || vec![Mat4::IDENTITY; 2];
-        let cases: Vec<(Vec<String>, Vec<u32>, Vec<Mat4>)> = vec![
-            (names(), vec![NO_PARENT], ibm()),
-            (names(), vec![NO_PARENT, 7], ibm()),
-            (names(), vec![1, 0], ibm()),
-            (names(), vec![NO_PARENT, 1], ibm()),
+        // Each case breaks one rule, and is refused for that rule.
+        type Case = (Vec<u32>, Vec<Mat4>, fn(&RuntimeError) -> bool);
+        let cases: Vec<Case> = vec![
+            (vec![NO_PARENT], ibm(), |e| {
+                matches!(e, RuntimeError::LengthMismatch { .. })
+            }),
+            (vec![NO_PARENT, 7], ibm(), |e| {
+                matches!(e, RuntimeError::ParentOutOfRange { parent: 7, .. })
+            }),
+            (vec![1, 0], ibm(), |e| {
+                matches!(e, RuntimeError::Cycle { .. })
+            }),
+            (vec![NO_PARENT, 1], ibm(), |e| {
+                matches!(e, RuntimeError::Cycle { joint: 1, .. })
+            }),
+            (vec![NO_PARENT, 0], vec![Mat4::IDENTITY, Mat4::ZERO], |e| {
+                matches!(e, RuntimeError::BadBindMatrix { joint: 1, .. })
+            }),
             (
-                names(),
-                vec![NO_PARENT, 0],
-                vec![Mat4::IDENTITY, Mat4::ZERO],
-            ),
-            (
-                names(),
                 vec![NO_PARENT, 0],
                 vec![Mat4::IDENTITY, Mat4::from_translation(Vec3::NAN)],
+                |e| matches!(e, RuntimeError::BadBindMatrix { joint: 1, .. }),
             ),
         ];
-        for (n, p, m) in cases {
-            assert!(Skeleton::new(n, p.clone(), m).is_err(), "accepted {p:?}");
+        for (p, m, expected) in cases {
+            match Skeleton::new(names(), p.clone(), m) {
+                Err(e) => assert!(expected(&e), "{p:?}: refused for another reason: {e:?}"),
+                Ok(_) => panic!("accepted {p:?}"),
+            }
         }
     }
 

@@ -160,28 +160,41 @@ mod tests {
         let rigid = Mat4::from_rotation_translation(Quat::from_rotation_x(1.0), Vec3::ONE);
         let mut projective = rigid;
         projective.x_axis.w = 0.5;
-        let cases = [
-            (vec![rigid], SkinningMethod::LinearBlend),
+        use RuntimeError::*;
+        // Each case breaks one rule and is refused for that rule.
+        type Case = (Vec<Mat4>, SkinningMethod, fn(&RuntimeError) -> bool);
+        let cases: [Case; 5] = [
+            (vec![rigid], SkinningMethod::LinearBlend, |e| {
+                matches!(e, BufferSize { .. })
+            }),
             (
                 vec![rigid, Mat4::from_translation(Vec3::NAN)],
                 SkinningMethod::LinearBlend,
+                |e| matches!(e, NonFinitePalette { joint: 1 }),
             ),
-            (vec![rigid, projective], SkinningMethod::LinearBlend),
+            (vec![rigid, projective], SkinningMethod::LinearBlend, |e| {
+                matches!(e, ProjectivePalette { joint: 1, .. })
+            }),
             (
                 vec![rigid, Mat4::from_scale(Vec3::splat(1.01))],
                 SkinningMethod::DualQuaternion,
+                |e| matches!(e, NonRigid { joint: 1, .. }),
             ),
             (
                 vec![rigid, Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0))],
                 SkinningMethod::DualQuaternion,
+                |e| matches!(e, NonRigid { joint: 1, .. }),
             ),
         ];
-        for (matrices, method) in cases {
+        for (matrices, method, expected) in cases {
             let mut palette = SkinningPalette::new(2);
-            assert!(
-                palette.update(&matrices, method).is_err(),
-                "accepted {matrices:?}"
-            );
+            match palette.update(&matrices, method) {
+                Err(e) => assert!(
+                    expected(&e),
+                    "{matrices:?}: refused for another reason: {e:?}"
+                ),
+                Ok(()) => panic!("accepted {matrices:?}"),
+            }
         }
         let mut palette = SkinningPalette::new(2);
         let scaled = [rigid, Mat4::from_scale(Vec3::splat(2.0))];

@@ -1,6 +1,7 @@
 //! `atlas-skin bench`: time linear blend and dual quaternion skinning of a character
-//! (positions and normals, up to 4 influences) over many frames, count the allocations a
-//! frame makes, and measure the machine's copy bandwidth in the same run.
+//! (positions and normals, up to 4 influences) over many frames, and measure the machine's
+//! copy bandwidth in the same run. (That a frame allocates nothing is a test of the runtime
+//! crate, `tests/no_allocation.rs`, whose binary alone counts allocations.)
 //!
 //! `bandwidth_fraction = vertices/s × bytes read and written per vertex ÷ copy bandwidth`:
 //! how close skinning comes to a plain copy of its streams. Near 1 the loop is memory
@@ -31,41 +32,8 @@ use atlas_skin_runtime::{
 };
 use glam::{Mat4, Vec3};
 use rayon::prelude::*;
-use std::alloc::{GlobalAlloc, Layout, System};
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
-
-/// The binary's allocator: the system allocator, counting every allocation so that the
-/// benchmark can report allocations per frame (a relaxed atomic increment per call).
-struct CountingAllocator;
-
-static ALLOCATIONS: AtomicU64 = AtomicU64::new(0);
-
-// SAFETY: forwards every call unchanged to `System`, which upholds the contract.
-unsafe impl GlobalAlloc for CountingAllocator {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        System.alloc(layout)
-    }
-
-    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        System.alloc_zeroed(layout)
-    }
-
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        System.realloc(ptr, layout, new_size)
-    }
-
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        System.dealloc(ptr, layout)
-    }
-}
-
-#[global_allocator]
-static GLOBAL: CountingAllocator = CountingAllocator;
 
 /// Distinct random poses cycled through the frames (palettes are prepared per frame).
 const POSES: usize = 16;
@@ -118,7 +86,6 @@ pub struct BenchReport {
     pub influences: usize,
     pub lbs_vertices_per_second: f64,
     pub dqs_vertices_per_second: f64,
-    pub allocations_per_frame: f64,
     /// Copy bandwidth counted as bytes read plus bytes written per second.
     pub memcpy_bytes_per_second: f64,
     /// Bytes a vertex reads (position, normal, joint indices, weights) and writes
@@ -180,7 +147,6 @@ pub fn run(args: Args) -> Result<()> {
             args.batch,
         )
     })?;
-    let frames = (args.frames * args.batch) as f64;
     let lbs_rate = count as f64 / timings.lbs;
     let dqs_rate = count as f64 / timings.dqs;
     let copy_bandwidth = streams.copy_bytes() as f64 / timings.copy;
@@ -194,7 +160,6 @@ pub fn run(args: Args) -> Result<()> {
         influences: streams.skin.influences(),
         lbs_vertices_per_second: lbs_rate,
         dqs_vertices_per_second: dqs_rate,
-        allocations_per_frame: timings.allocations as f64 / (2.0 * frames),
         memcpy_bytes_per_second: copy_bandwidth,
         bytes_per_vertex: bytes,
         bandwidth_fraction: lbs_rate * bytes as f64 / copy_bandwidth,
@@ -224,10 +189,9 @@ fn print_report(r: &BenchReport) {
         100.0 * r.dqs_bandwidth_fraction
     );
     println!(
-        "copy bandwidth:  {:8.1} GB/s read + written; {} bytes per vertex; {} allocations per frame",
+        "copy bandwidth:  {:8.1} GB/s read + written; {} bytes per vertex",
         r.memcpy_bytes_per_second / 1e9,
-        r.bytes_per_vertex,
-        r.allocations_per_frame
+        r.bytes_per_vertex
     );
 }
 
@@ -329,13 +293,11 @@ fn bytes_per_vertex(k: usize) -> usize {
     2 * vec3 + 2 * k + 4 * (k - 1) + 2 * vec3
 }
 
-/// Median seconds of a frame of each method and of a copy pass, and the allocations the
-/// frames made.
+/// Median seconds of a frame of each method and of a copy pass.
 struct Timings {
     lbs: f64,
     dqs: f64,
     copy: f64,
-    allocations: u64,
 }
 
 /// Times `frames` rounds of: `batch` linear blend frames, `batch` dual quaternion frames
@@ -353,10 +315,8 @@ fn measure(
     let mut lbs_palette = SkinningPalette::new(joints);
     let mut dqs_palette = SkinningPalette::new(joints);
     let mut seconds = [vec![0.0; frames], vec![0.0; frames], vec![0.0; frames]];
-    let mut allocations = 0;
     for round in 0..=frames {
         let poses = || (round * batch..(round + 1) * batch).map(|f| &palettes[f % palettes.len()]);
-        let before = ALLOCATIONS.load(Ordering::Relaxed);
         let lbs = streams.skin_frames(
             &mut lbs_palette,
             poses(),
@@ -369,14 +329,12 @@ fn measure(
             SkinningMethod::DualQuaternion,
             threading,
         )?;
-        let after = ALLOCATIONS.load(Ordering::Relaxed);
         let copy = streams.copy_passes(batch);
         // Round 0 warms up.
         if let Some(previous) = round.checked_sub(1) {
             for (samples, s) in seconds.iter_mut().zip([lbs, dqs, copy]) {
                 samples[previous] = s;
             }
-            allocations += after - before;
         }
     }
     std::hint::black_box((
@@ -385,12 +343,7 @@ fn measure(
         &streams.copy_target,
     ));
     let [lbs, dqs, copy] = seconds.map(median);
-    Ok(Timings {
-        lbs,
-        dqs,
-        copy,
-        allocations,
-    })
+    Ok(Timings { lbs, dqs, copy })
 }
 
 /// The median of a non-empty sample.

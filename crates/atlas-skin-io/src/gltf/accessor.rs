@@ -466,14 +466,22 @@ mod tests {
         doc_with(&json, &buffer, |doc| {
             let v = read_floats(doc, 0, "VEC2", "test").unwrap();
             assert_eq!(v, vec![0.0, 1.0, 128.0 / 255.0, 64.0 / 255.0]);
+            let invalid = |result: Result<Vec<_>, IoError>, words: &str| matches!(&result, Err(IoError::Invalid { message, .. }) if message.contains(words));
+            let past_the_view = read_floats(doc, 1, "VEC2", "test");
             assert!(
-                read_floats(doc, 1, "VEC2", "test").is_err(),
+                invalid(past_the_view, "test"),
                 "third element past the view"
             );
-            assert!(read_floats(doc, 0, "VEC3", "test").is_err(), "wrong type");
+            assert!(
+                invalid(read_floats(doc, 0, "VEC3", "test"), "VEC"),
+                "wrong type"
+            );
             assert_eq!(read_uints(doc, 2, "SCALAR", "test").unwrap(), vec![0, 9, 0]);
             assert!(
-                read_uints(doc, 0, "VEC2", "test").is_err(),
+                matches!(
+                    read_uints(doc, 0, "VEC2", "test"),
+                    Err(IoError::Invalid { .. })
+                ),
                 "normalized is not an index"
             );
         });

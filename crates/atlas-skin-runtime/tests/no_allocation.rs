@@ -1,0 +1,97 @@
+//! A frame allocates nothing: preparing the palette and skinning positions and normals, by
+//! linear blend and by dual quaternions, with every instruction set this CPU runs, on one
+//! thread. This test binary alone replaces the global allocator by one that counts (the
+//! library and the `atlas-skin` binary use the system's unchanged).
+
+use atlas_skin_runtime::random_pose::{random_rotations, SplitMix64};
+use atlas_skin_runtime::{
+    CompactSkin, InstructionSet, SkinningJob, SkinningMethod, SkinningPalette, Threading,
+    VertexWeights,
+};
+use glam::{Mat4, Vec3};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// The system allocator, counting every allocation of this test binary.
+struct CountingAllocator;
+
+static ALLOCATIONS: AtomicU64 = AtomicU64::new(0);
+
+// SAFETY: forwards every call unchanged to `System`, which upholds the contract.
+unsafe impl GlobalAlloc for CountingAllocator {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        System.alloc(layout)
+    }
+
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        System.alloc_zeroed(layout)
+    }
+
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        System.realloc(ptr, layout, new_size)
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        System.dealloc(ptr, layout)
+    }
+}
+
+#[global_allocator]
+static GLOBAL: CountingAllocator = CountingAllocator;
+
+#[test]
+fn a_frame_allocates_nothing() {
+    const JOINTS: usize = 16;
+    const VERTICES: usize = 5_000;
+    let mut rng = SplitMix64::new(3);
+    let rest: Vec<Vec3> = (0..VERTICES).map(|_| rng.unit_vector()).collect();
+    let normals: Vec<Vec3> = (0..VERTICES).map(|_| rng.unit_vector()).collect();
+    let weights = VertexWeights::from_rows((0..VERTICES).map(|v| {
+        (0..1 + v % 4)
+            .map(|k| (((v + 5 * k) % JOINTS) as u32, 0.1 + k as f32))
+            .collect::<Vec<_>>()
+    }));
+    let skin = CompactSkin::new(&weights, JOINTS, 4).expect("valid weights");
+    let poses: Vec<Vec<Mat4>> = (0..4)
+        .map(|seed| {
+            random_rotations(JOINTS, 1.0, seed)
+                .into_iter()
+                .map(|q| Mat4::from_rotation_translation(q, Vec3::X))
+                .collect()
+        })
+        .collect();
+    let mut out_positions = vec![Vec3::ZERO; VERTICES];
+    let mut out_normals = vec![Vec3::ZERO; VERTICES];
+    for set in InstructionSet::ALL.into_iter().filter(|s| s.is_supported()) {
+        for method in [SkinningMethod::LinearBlend, SkinningMethod::DualQuaternion] {
+            let mut palette = SkinningPalette::new(JOINTS);
+            let mut frame = |pose: &[Mat4]| {
+                palette.update(pose, method).expect("rigid palette");
+                SkinningJob {
+                    skin: &skin,
+                    palette: &palette,
+                    threading: Threading::Sequential,
+                    rest_positions: &rest,
+                    rest_normals: Some(&normals),
+                    rest_tangents: None,
+                    out_positions: &mut out_positions,
+                    out_normals: Some(&mut out_normals),
+                    out_tangents: None,
+                }
+                .run_with(set)
+                .expect("valid job");
+            };
+            // The first frame may set up lazily (CPU feature detection); the others count.
+            frame(&poses[0]);
+            let before = ALLOCATIONS.load(Ordering::Relaxed);
+            for pose in &poses {
+                frame(pose);
+            }
+            let allocations = ALLOCATIONS.load(Ordering::Relaxed) - before;
+            assert_eq!(allocations, 0, "{} {method:?}", set.name());
+        }
+    }
+}
