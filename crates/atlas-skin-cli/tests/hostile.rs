@@ -198,7 +198,7 @@ fn cases() -> Vec<Case> {
         bad_buffer("buffer-absolute", "/etc/passwd", "absolute path"),
         bad_buffer(
             "buffer-dev-zero",
-            "../../../../../../../../dev/zero",
+            "../../../../../../../../../../../../../../../../dev/zero",
             "outside",
         ),
         bad_buffer(
@@ -313,7 +313,10 @@ fn cases() -> Vec<Case> {
         },
         bad_image("image-dotdot", "../secret.bin"),
         bad_image("image-absolute", "/etc/passwd"),
-        bad_image("image-dev-urandom", "../../../../../../../../dev/urandom"),
+        bad_image(
+            "image-dev-urandom",
+            "../../../../../../../../../../../../../../../../dev/urandom",
+        ),
         Case {
             name: "output-is-a-fifo",
             files: plus(riggedsimple(), "out.glb", Source::Fifo),

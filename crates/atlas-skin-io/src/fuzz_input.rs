@@ -22,11 +22,13 @@ pub enum Format {
     SkeletonJson,
     Dmat,
     Mhw,
+    Fbx,
+    RigInfo,
 }
 
 impl Format {
     /// Every reader.
-    pub const ALL: [Format; 12] = [
+    pub const ALL: [Format; 14] = [
         Self::Gltf,
         Self::Obj,
         Self::Ply,
@@ -39,6 +41,8 @@ impl Format {
         Self::SkeletonJson,
         Self::Dmat,
         Self::Mhw,
+        Self::Fbx,
+        Self::RigInfo,
     ];
 
     /// The fuzz target's name (and its corpus folder's).
@@ -62,11 +66,14 @@ impl Format {
             Self::SkeletonJson => ("skeleton_json", "json"),
             Self::Dmat => ("dmat", "dmat"),
             Self::Mhw => ("mhw", "mhw"),
+            Self::Fbx => ("fbx", "fbx"),
+            Self::RigInfo => ("rig_info", "txt"),
         }
     }
 }
 
-/// Base-mesh vertices the MakeHuman readers index (`mhskel` heads and tails, `mhw` rows).
+/// Mesh vertices the readers that index a mesh are given (`mhskel` heads and tails, `mhw`
+/// rows, `rig_info` skin lines).
 const MAKEHUMAN_VERTICES: usize = 64;
 
 /// The folder of `format`'s scratch file for this process: empty but for that file, so a
@@ -126,5 +133,7 @@ fn read_file(format: Format, path: &Path) -> Result<(), IoError> {
             })?;
             crate::mhw::read(path, &skeleton, MAKEHUMAN_VERTICES).map(drop)
         }
+        Format::Fbx => crate::fbx::read(path).map(drop),
+        Format::RigInfo => crate::rig_info::read(path, MAKEHUMAN_VERTICES).map(drop),
     }
 }

@@ -110,6 +110,9 @@ pub(crate) fn mesh_instances(
     let mut to_bind_of_skin: HashMap<usize, Option<Mat4>> = HashMap::new();
     // Every node's world transform, computed once (linear in the node count).
     let worlds = tree.worlds();
+    let joint_of = skin
+        .map(|(_, joints, _)| node_positions(joints))
+        .unwrap_or_default();
     for (node, object) in doc.array("nodes")?.iter().enumerate() {
         let location = format!("nodes[{node}]");
         let Some(mesh) = doc.opt_index(object, &location, "mesh")? else {
@@ -158,7 +161,7 @@ pub(crate) fn mesh_instances(
                     }
                 }
             }
-            None => match joint_ancestor(tree, joints, node) {
+            None => match joint_ancestor(tree, &joint_of, node) {
                 Some((joint, joint_node)) => rigid.push(MeshInstance {
                     node,
                     mesh,
@@ -231,16 +234,31 @@ fn shared_bind(
     Ok(Some(binds[0].inverse() * other_binds[k]))
 }
 
-/// `node` or its nearest ancestor that is one of `joints`: its skeleton index and node.
-fn joint_ancestor(tree: &NodeTree, joints: &[usize], node: usize) -> Option<(u32, usize)> {
+/// `node` or its nearest ancestor that is a joint (`joint_of`: node → skeleton index, from
+/// [`node_positions`]): its skeleton index and node.
+fn joint_ancestor(
+    tree: &NodeTree,
+    joint_of: &HashMap<usize, u32>,
+    node: usize,
+) -> Option<(u32, usize)> {
     let mut current = Some(node);
     while let Some(ancestor) = current {
-        if let Some(j) = joints.iter().position(|&n| n == ancestor) {
-            return Some((j as u32, ancestor));
+        if let Some(&j) = joint_of.get(&ancestor) {
+            return Some((j, ancestor));
         }
         current = tree.parents[ancestor];
     }
     None
+}
+
+/// The position of every node in `nodes` (a skin's or the skeleton's joint list): node →
+/// index, so that lookups stay linear in the joint count.
+pub(crate) fn node_positions(nodes: &[usize]) -> HashMap<usize, u32> {
+    nodes
+        .iter()
+        .enumerate()
+        .map(|(i, &n)| (n, i as u32))
+        .collect()
 }
 
 /// `nodes[i]` with the node's name when it has one.

@@ -3,7 +3,9 @@
 
 use super::accessor::{read_floats, read_uints};
 use super::animation::{read_clips, read_rig};
-use super::bindings::{inverse_binds, mesh_instances, skin_joints, Binding, MeshInstance};
+use super::bindings::{
+    inverse_binds, mesh_instances, node_positions, skin_joints, Binding, MeshInstance,
+};
 use super::budget::DecodeBudget;
 use super::container::read_container;
 use super::document::Document;
@@ -408,9 +410,10 @@ fn read_reference_weights(
                 continue;
             }
         };
+        let skeleton_index = node_positions(skeleton_nodes);
         let skeleton_joint: Vec<u32> = skin_joints(doc, skin)?
             .iter()
-            .map(|node| skeleton_nodes.iter().position(|n| n == node).unwrap_or(0) as u32)
+            .map(|node| skeleton_index.get(node).copied().unwrap_or(0))
             .collect();
         let joint_count = skeleton_joint.len();
         let mut block_rows = vec![Vec::new(); block.count];

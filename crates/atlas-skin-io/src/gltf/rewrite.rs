@@ -1,6 +1,7 @@
 //! New skin weights into a copy of the input glTF document, everything else preserved.
 
 use super::animation::append_clips;
+use super::bindings::node_positions;
 use super::builder::{component_bounds, GlbBuilder};
 use super::prune::{drop_orphans, References};
 use super::write::{
@@ -378,9 +379,10 @@ fn in_skin_order(
     skeleton_nodes: &[usize],
     skin_nodes: &[usize],
 ) -> VertexWeights {
+    let skin_index = node_positions(skin_nodes);
     let index_in_skin: Vec<u32> = skeleton_nodes
         .iter()
-        .map(|node| skin_nodes.iter().position(|n| n == node).unwrap_or(0) as u32)
+        .map(|node| skin_index.get(node).copied().unwrap_or(0))
         .collect();
     VertexWeights::from_rows(vertices.map(|v| {
         weights
