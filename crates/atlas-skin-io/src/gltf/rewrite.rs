@@ -150,7 +150,14 @@ fn set_position_bounds(json: &mut Map<String, Value>, character: &Character, sou
     let Some(Value::Array(accessors)) = json.get_mut("accessors") else {
         return;
     };
-    for primitive in &source.primitives {
+    // Only the first skin's primitives hold the stored positions: those of other skins and
+    // rigid meshes were moved into its bind space when read, and keep their own bounds.
+    let stored_as_read = |p: &&super::PrimitiveSource| match (p.binding, source.skin) {
+        (Binding::Skin(skin), Some(first)) => skin == first,
+        (Binding::Unskinned, _) => true,
+        _ => false,
+    };
+    for primitive in source.primitives.iter().filter(stored_as_read) {
         let Some(Value::Object(accessor)) = accessors.get_mut(primitive.position_accessor) else {
             continue;
         };
