@@ -22,7 +22,7 @@ use std::path::Path;
 ///
 /// - Skin: the first skin used by a node that also has a mesh. The meshes of every skin
 ///   over the same joints, then the rigid meshes under a joint node (see
-///   [`mesh_instances`]): their triangle primitives (TRIANGLES, or strips and fans
+///   `mesh_instances`): their triangle primitives (TRIANGLES, or strips and fans
 ///   converted) are concatenated, positions in the first skin's bind space (stored
 ///   positions for its own meshes; node transforms of skinned meshes are not applied).
 ///   Without a skin, every mesh node's triangles are read with the node's world transform

@@ -36,7 +36,7 @@ const LISTED: usize = 8;
 /// Joints within [`NEGLIGIBLE`] × the mesh diagonal of each other sit at one point.
 ///
 /// # Errors
-/// [`PlacementError::BesideMesh`] when every joint lies farther than [`BOX_MARGIN`] × the diagonal outside the mesh's
+/// [`PlacementError::BesideMesh`] when every joint lies farther than `BOX_MARGIN` × the diagonal outside the mesh's
 /// bounding box.
 pub fn check_placement(
     skeleton: &Skeleton,
