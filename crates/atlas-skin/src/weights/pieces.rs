@@ -33,6 +33,7 @@
 //! edges (Dijkstra), so that weight never crosses between touching parts of a piece: the
 //! **fallback**, counted and warned about.
 
+pub use super::surface_weights::{PieceTreatment, PieceWeighting};
 use super::surface_weights::{SurfaceWeights, WeightCounts};
 use crate::decomposition::Decomposition;
 use crate::mesh::edge_distance::EdgeDistances;
@@ -41,31 +42,6 @@ use crate::skeleton::bones::{bone_segments, nearest_bone_with_distance, NearestB
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
 use rayon::prelude::*;
-use serde::Serialize;
-
-/// How a piece was weighted.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case", tag = "treatment", content = "joint")]
-pub enum PieceTreatment {
-    /// Decomposed with the joints it holds (steps 1–3).
-    Body,
-    /// Weights of the nearest point of the body surface.
-    Attached,
-    /// Weight 1 on one joint.
-    Rigid(u32),
-    /// Every vertex bound to its nearest bone.
-    Bones,
-}
-
-/// One piece of the split surface and how it was weighted.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
-pub struct PieceWeighting {
-    #[serde(flatten)]
-    pub treatment: PieceTreatment,
-    pub vertices: usize,
-    /// Vertices of a body piece that no region with joints reaches (the fallback).
-    pub fallback_vertices: usize,
-}
 
 /// Step 4: weights every vertex steps 1–3 left without weights, piece by piece (module
 /// documentation); returns the counts and how each piece was weighted.

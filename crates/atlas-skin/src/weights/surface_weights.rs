@@ -53,11 +53,35 @@ pub struct WeightCounts {
     /// Of those, vertices of pieces bound rigidly to one joint.
     pub rigid: usize,
     /// Every piece (connected component of the split surface) and how it was weighted.
-    pub pieces: Vec<super::pieces::PieceWeighting>,
+    pub pieces: Vec<PieceWeighting>,
     /// Joints whose soft boundary is inactive (no cross-section near the joint).
     pub inactive_soft_joints: Vec<u32>,
     /// Leaf joints that move a patch of skin (step 3b).
     pub leaf_patches: Vec<u32>,
     /// Vertices whose weights on far joints the guard removed (step 5).
     pub far_bone_vertices: usize,
+}
+
+/// How a piece was weighted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case", tag = "treatment", content = "joint")]
+pub enum PieceTreatment {
+    /// Decomposed with the joints it holds (steps 1–3).
+    Body,
+    /// Weights of the nearest point of the body surface.
+    Attached,
+    /// Weight 1 on one joint.
+    Rigid(u32),
+    /// Every vertex bound to its nearest bone.
+    Bones,
+}
+
+/// One piece of the split surface and how it was weighted.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct PieceWeighting {
+    #[serde(flatten)]
+    pub treatment: PieceTreatment,
+    pub vertices: usize,
+    /// Vertices of a body piece that no region with joints reaches (the fallback).
+    pub fallback_vertices: usize,
 }
