@@ -11,11 +11,17 @@ use glam::DVec3;
 /// w ≈ 1 inside a closed outward-oriented surface, 0 outside, fractional near holes.
 /// Cost O(F) per point.
 pub fn winding_number(mesh: &SurfaceMesh, p: DVec3) -> f64 {
+    faces_winding_number(&mesh.positions, &mesh.triangles, p)
+}
+
+/// [`winding_number`] of the surface made of `triangles` over `positions` (a part of a
+/// mesh, without copying its points).
+pub fn faces_winding_number(positions: &[DVec3], triangles: &[[u32; 3]], p: DVec3) -> f64 {
     let mut total = 0.0;
-    for t in &mesh.triangles {
-        let a = mesh.positions[t[0] as usize] - p;
-        let b = mesh.positions[t[1] as usize] - p;
-        let c = mesh.positions[t[2] as usize] - p;
+    for t in triangles {
+        let a = positions[t[0] as usize] - p;
+        let b = positions[t[1] as usize] - p;
+        let c = positions[t[2] as usize] - p;
         let (la, lb, lc) = (a.length(), b.length(), c.length());
         let numerator = a.dot(b.cross(c));
         let denominator = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
