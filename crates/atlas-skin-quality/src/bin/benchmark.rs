@@ -55,6 +55,11 @@ struct Args {
     /// and the change of the aggregates.
     #[arg(long)]
     compare: Option<PathBuf>,
+    /// Settings for every `skin` run (`atlas-skin skin --config FILE.json`), to measure
+    /// other settings than the defaults on the whole benchmark. A run with it writes its
+    /// page under target/benchmark/ unless --out says otherwise.
+    #[arg(long, value_name = "FILE.json")]
+    skin_config: Option<PathBuf>,
 }
 
 fn main() -> Result<()> {
@@ -83,6 +88,14 @@ fn main() -> Result<()> {
         characters.retain(|c| args.characters.contains(&c.name));
     }
 
+    if let Some(config) = &args.skin_config {
+        let config = std::fs::canonicalize(config)
+            .with_context(|| format!("cannot read the settings file {}", config.display()))?;
+        for character in &mut characters {
+            character.skin_args.push("--config".into());
+            character.skin_args.push(config.clone().into_os_string());
+        }
+    }
     let exe = run::atlas_skin_exe()?;
     let jobs = args
         .jobs
@@ -113,7 +126,7 @@ fn main() -> Result<()> {
 
     write(&args.json, &serde_json::to_string_pretty(&run)?)?;
     let page = bench_page::render(&run, &bench_table, &models_table, true);
-    let whole = args.sets.is_empty() && args.characters.is_empty();
+    let whole = args.sets.is_empty() && args.characters.is_empty() && args.skin_config.is_none();
     let out = args.out.clone().unwrap_or_else(|| {
         if whole {
             Path::new(WORKSPACE).join("docs/benchmark.md")
