@@ -18,7 +18,7 @@ use crate::cuts::plane_section::{diameter, vertex_snap_distances};
 use crate::cuts::split::split_along_curves;
 use crate::decomposition::{Boundary, BoundaryKind, Decomposition, JointDecision, JointStatus};
 use crate::mesh::{FaceSpheres, SurfaceMesh, Topology};
-use crate::regions::{bind_regions, grow_regions, side_regions};
+use crate::regions::{bind_parent_sides, bind_regions, grow_regions, side_regions};
 use crate::skeleton::bones::{bones_not_at, joint_pairs};
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
@@ -93,20 +93,23 @@ pub fn decompose(
             })
             .collect()
     };
-    let (joint_region, regions) = bind_regions(
+    let cut_parent = sides(false);
+    let (joint_region, mut regions) = bind_regions(
         &surface,
         &face_region,
         region_count,
         skeleton,
         &positions,
         &sides(true),
-        &sides(false),
+        &cut_parent,
     );
 
     let (boundaries, mut joints) = decide_joints(skeleton, outcomes, &joint_region, &searches);
     for (decision, plan) in joints.iter_mut().zip(&plans) {
         decision.owns_skin = !matches!(plan, JointPlan::Exclude(_));
     }
+    let owns_skin: Vec<bool> = joints.iter().map(|d| d.owns_skin).collect();
+    bind_parent_sides(&mut regions, skeleton, &cut_parent, &owns_skin);
     Ok(Decomposition {
         topology: split_topology,
         welded_vertex_count: mesh.vertex_count(),

@@ -28,8 +28,9 @@ pub struct Decomposition {
 #[derive(Debug, Clone, Serialize)]
 pub struct Region {
     /// Joints that move this region, ordered along the chain from the root side; the first
-    /// is the joint the region is bound to. Empty when no joint reaches the region (a loose
-    /// piece): the weights stage then takes weights from the nearest weighted surface.
+    /// is the joint the region is bound to. Empty when no joint reaches the region and it
+    /// lies on the parent side of no cut (a loose piece, a sliver between cut loops): the
+    /// weights stage then weights it as a piece or from the nearest weighted surface.
     pub joints: Vec<u32>,
     pub faces: usize,
     pub vertices: usize,

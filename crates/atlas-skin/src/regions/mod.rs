@@ -7,7 +7,10 @@
 //!
 //! Binding: the region of a cut joint is its child region; a joint without a cut lies in
 //! its parent's region; a root without a cut lies in the parent region of the first cut
-//! below it (or, with no cut below, in the region of the face nearest to it). A region's
+//! below it (or, with no cut below, in the region of the face nearest to it). A region
+//! that no joint is bound to but that lies on the parent side of a cut moves with that
+//! cut's joint's nearest ancestor that owns skin ([`bind_parent_sides`]): a torso whose
+//! root joint lies outside it, the part of a leg piece above its hip cut. A region's
 //! joints are listed bound joint first — the cut joint whose child region it is, else its
 //! joint nearest the root — then the others in the skeleton's topological order (along the
 //! chain, parents before children).
@@ -172,6 +175,50 @@ pub fn bind_regions(
     (joint_region, regions)
 }
 
+/// Binds every region that no joint is bound to but that lies on the parent side of a cut
+/// (a torso whose root joint lies outside it and was bound beside it; the part of a leg
+/// piece above a hip cut whose parent lies in another piece) to the joint that moves that
+/// side: the cut joint's nearest ancestor that owns skin. Of several such cuts, the
+/// ancestor nearest the root wins. Returns how many regions were bound.
+///
+/// - `cut_parent`: #J parent region of every joint with a separating cut.
+/// - `owns_skin`: #J whether the joint may take weight.
+pub fn bind_parent_sides(
+    regions: &mut [Region],
+    skeleton: &Skeleton,
+    cut_parent: &[Option<u32>],
+    owns_skin: &[bool],
+) -> usize {
+    let order = skeleton.topological_order();
+    let mut rank = vec![0usize; skeleton.len()];
+    for (k, &j) in order.iter().enumerate() {
+        rank[j] = k;
+    }
+    let mut chosen: Vec<Option<u32>> = vec![None; regions.len()];
+    for (k, parent_side) in cut_parent.iter().enumerate() {
+        let Some(r) = *parent_side else { continue };
+        if !regions[r as usize].joints.is_empty() {
+            continue;
+        }
+        let Some(mover) = skeleton.ancestors(k).find(|&a| owns_skin[a]) else {
+            continue;
+        };
+        let slot = &mut chosen[r as usize];
+        match *slot {
+            Some(j) if rank[j as usize] <= rank[mover] => {}
+            _ => *slot = Some(mover as u32),
+        }
+    }
+    let mut bound = 0;
+    for (region, joint) in regions.iter_mut().zip(chosen) {
+        if let Some(joint) = joint {
+            region.joints.push(joint);
+            bound += 1;
+        }
+    }
+    bound
+}
+
 fn nearest_face_region(mesh: &SurfaceMesh, face_region: &[u32], p: DVec3) -> Option<u32> {
     (0..mesh.triangle_count())
         .map(|f| {
@@ -180,4 +227,76 @@ fn nearest_face_region(mesh: &SurfaceMesh, face_region: &[u32], p: DVec3) -> Opt
         })
         .min_by(|x, y| x.0.total_cmp(&y.0))
         .map(|(_, r)| r)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use atlas_skin_runtime::NO_PARENT;
+    use glam::Vec3;
+
+    fn region(joints: Vec<u32>) -> Region {
+        Region {
+            joints,
+            faces: 1,
+            vertices: 3,
+        }
+    }
+
+    #[test]
+    fn a_region_without_joints_on_the_parent_side_of_a_cut_moves_with_the_cut_joints_parent() {
+        // root (0) → spine (1) → arm (2) → hand (3), and a second branch root → leg (4).
+        // Region 0 lies on the parent side of the arm's cut and of the leg's cut, region 1
+        // is the arm's, region 2 the hand's, region 3 the leg's; region 4 lies on the parent
+        // side of nothing.
+        let skeleton = Skeleton::from_positions(
+            ["root", "spine", "arm", "hand", "leg"]
+                .map(String::from)
+                .to_vec(),
+            vec![NO_PARENT, 0, 1, 2, 0],
+            &[Vec3::ZERO, Vec3::Y, Vec3::X, 2.0 * Vec3::X, -Vec3::Y],
+        )
+        .expect("a valid skeleton");
+        let cut_parent = [None, None, Some(0), Some(1), Some(0)];
+        let fresh = || {
+            vec![
+                region(vec![]),
+                region(vec![2]),
+                region(vec![3]),
+                region(vec![4]),
+                region(vec![]),
+            ]
+        };
+        // Of the two movers (spine for the arm's cut, root for the leg's), the root wins.
+        let mut regions = fresh();
+        assert_eq!(
+            bind_parent_sides(&mut regions, &skeleton, &cut_parent, &[true; 5]),
+            1
+        );
+        assert_eq!(regions[0].joints, vec![0]);
+        assert!(regions[4].joints.is_empty());
+        assert_eq!(regions[1].joints, vec![2], "bound regions stay as they are");
+        // A root that may not take weight (outside the body) hands the side to the spine.
+        let mut regions = fresh();
+        bind_parent_sides(
+            &mut regions,
+            &skeleton,
+            &cut_parent,
+            &[false, true, true, true, true],
+        );
+        assert_eq!(regions[0].joints, vec![1]);
+        // No ancestor may take weight: the region stays without joints.
+        let mut regions = fresh();
+        let none = [false, false, true, true, true];
+        assert_eq!(
+            bind_parent_sides(
+                &mut regions,
+                &skeleton,
+                &[None, None, None, None, Some(0)],
+                &none
+            ),
+            0
+        );
+        assert!(regions[0].joints.is_empty());
+    }
 }
