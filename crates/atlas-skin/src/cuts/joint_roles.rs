@@ -14,10 +14,9 @@
 //!    needs only a locally outward surface.
 //! 4. A branching joint (two or more children) on the skeleton's mirror plane (pelvis,
 //!    chest, head, jaw). The paper gives it no boundary; here (METHOD.md, "extensions") it
-//!    gets one when it owns a part of the trunk. Nearer to the surface than a quarter of its
-//!    shortest bone (a jaw or tongue root in the mouth) it lies at the skin, not in a trunk:
-//!    no boundary (docs/measurements.md says what this rule and the next are worth).
-//!    Otherwise where its branches start is judged against its section's diameter
+//!    gets one when it owns a part of the trunk (docs/measurements.md says what this rule
+//!    is worth, and why a joint near the skin is not exempt: a head in a thin neck is).
+//!    Where its branches start is judged against its section's diameter
 //!    D = 2 × surface distance. Most child bones (the median) shorter than D: it sits at
 //!    the junction (a chest between shoulders and neck), its children's boundaries enclose
 //!    most of it, so no cut fits; but the trunk below them bends with it, as artists weight
@@ -106,10 +105,6 @@ const ON_PLANE: f64 = 0.25;
 /// many times the joint's surface distance past it (a toe beyond the ball of a foot reaches
 /// 2–7 times; a fingertip cap around an end site about 1.4–1.7 times).
 const LEAF_REACH_RATIO: f64 = 2.0;
-
-/// Rule 4: a branching joint on the mirror plane lies in a trunk when its surface distance
-/// is at least this fraction of its shortest bone.
-const TRUNK_DEPTH: f64 = 0.25;
 
 /// Rule 5 (b) counts the vertices within 60° of the leaf's bone (cos 60° = ½): toes turn
 /// about 45° from a foot bone, while the rim of a broad flat end (a pad under an end site)
@@ -275,19 +270,12 @@ impl Rig<'_> {
     }
 }
 
-/// Rule 4 for a branching joint on the mirror plane: no boundary near the skin, a soft one
-/// where its branches start within its cross-section, `None` (a cut) otherwise.
+/// Rule 4 for a branching joint on the mirror plane: a soft boundary where its branches
+/// start within its cross-section, `None` (a cut) otherwise.
 fn branching_plan(frame: &JointFrame, child_vectors: &[DVec3]) -> Option<JointPlan> {
-    let (surface_distance, bone_length) = (frame.surface_distance, frame.bone_length);
     let mut child_lengths: Vec<f64> = child_vectors.iter().map(|v| v.length()).collect();
     child_lengths.sort_unstable_by(f64::total_cmp);
-    let section_diameter = 2.0 * surface_distance;
-    if surface_distance < TRUNK_DEPTH * bone_length {
-        return Some(JointPlan::Skip(format!(
-            "branching joint on the mirror plane near the skin, not in a trunk: \
-             surface {surface_distance:.4} away, shortest bone {bone_length:.4}"
-        )));
-    }
+    let section_diameter = 2.0 * frame.surface_distance;
     let median = child_lengths[child_lengths.len() / 2];
     if median < section_diameter {
         return Some(JointPlan::Soft(
