@@ -2,12 +2,12 @@
 //! weights for every stored vertex, a smooth transition at the joint, settings checked
 //! before any work.
 
-use atlas_skin::fixtures::shapes::bent_cylinder;
+use atlas_skin::fixtures::shapes::{bent_cylinder, capsule_chain};
 use atlas_skin::overlap::OverlapError;
 use atlas_skin::pipeline::{skin, SettingsError, SkinError, SkinInput, SkinParams, Stage};
 use atlas_skin::DecomposeError;
 use atlas_skin_runtime::Skeleton;
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
 fn input<'a>(
     positions: &'a [Vec3],
@@ -114,5 +114,70 @@ fn bad_settings_are_refused_before_any_work() {
             Ok(_) => panic!("expected {expected:?}, got weights"),
         }
         assert!(stages.is_empty());
+    }
+}
+
+#[test]
+fn weights_along_a_long_bent_tube_rise_and_fall_once_per_joint() {
+    // A tube bent twice in the XY plane: root (0) → joint1 (bend 30°) → joint2 (bend 40°
+    // more) → end site. Along every line of the tube's wall (the same angle around the
+    // axis), each joint's weight rises to its maximum and then falls, never rising again.
+    const SIDES: usize = 16;
+    let direction = |degrees: f64| {
+        let a = degrees.to_radians();
+        DVec3::new(a.sin(), a.cos(), 0.0)
+    };
+    let mut points = vec![DVec3::ZERO];
+    for degrees in [0.0, 30.0, 70.0] {
+        let last = *points.last().expect("a point");
+        points.push(last + 4.0 * direction(degrees));
+    }
+    let (mesh, skeleton) = capsule_chain(
+        &points,
+        &["root", "joint1", "joint2", "end"],
+        0.5,
+        SIDES,
+        24,
+    );
+    let positions: Vec<Vec3> = mesh.positions.iter().map(|p| p.as_vec3()).collect();
+    let skinned = skin(
+        input(&positions, &mesh.triangles, &skeleton),
+        &SkinParams::default(),
+        &mut |_| {},
+    )
+    .expect("skinned");
+    // Lines of the wall: `capsule_chain` stores a pole, then rings of SIDES vertices from
+    // the root's end to the tip's, then the other pole; vertex k of every ring lies on one
+    // line along the tube.
+    let rings = (mesh.positions.len() - 2) / SIDES;
+    let lines: Vec<Vec<usize>> = (0..SIDES)
+        .map(|k| (0..rings).map(|r| 1 + r * SIDES + k).collect())
+        .collect();
+    for line in &lines {
+        for joint in 0..3u32 {
+            let weights: Vec<f32> = line
+                .iter()
+                .map(|&v| {
+                    skinned
+                        .weights
+                        .row(v)
+                        .find(|&(j, _)| j == joint)
+                        .map_or(0.0, |(_, w)| w)
+                })
+                .collect();
+            let peak = (0..weights.len())
+                .max_by(|&a, &b| weights[a].total_cmp(&weights[b]))
+                .unwrap_or(0);
+            assert!(weights[peak] > 0.99, "joint {joint} owns a core");
+            for k in 1..weights.len() {
+                let step = weights[k] - weights[k - 1];
+                let ok = if k <= peak {
+                    step >= -1e-5
+                } else {
+                    step <= 1e-5
+                };
+                assert!(ok, "joint {joint} along a line of the wall: {weights:?}");
+            }
+        }
     }
 }
