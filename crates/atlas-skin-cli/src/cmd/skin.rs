@@ -333,6 +333,7 @@ fn pieces_report(decomposition: &Decomposition, counts: &WeightCounts) -> Value 
             PieceTreatment::Attached => ("attached", None),
             PieceTreatment::Rigid(j) => ("rigid", Some(j)),
             PieceTreatment::Bones => ("bones", None),
+            PieceTreatment::Joints => ("joints", None),
         };
         let entry = summary
             .entry(name)

@@ -153,7 +153,7 @@ pub fn compute_weights(
     let patches = leaf_patches(decomposition, skeleton, &active, &region_vertices);
     let trees = region_trees(decomposition, skeleton, &softs);
     let mut weights = blend_vertices(decomposition, &related, &softs, &patches, &trees, blend);
-    let mut counts = weight_pieces(decomposition, skeleton, &mut weights);
+    let mut counts = weight_pieces(decomposition, skeleton, overlaps, &mut weights);
     counts.leaf_patches = patches.iter().map(|p| p.joint).collect();
     counts.inactive_soft_joints = decomposition
         .boundaries

@@ -74,6 +74,8 @@ pub enum PieceTreatment {
     Rigid(u32),
     /// Every vertex bound to its nearest bone.
     Bones,
+    /// Bent at the boundary planes of the joints whose bones it holds.
+    Joints,
 }
 
 /// One piece of the split surface and how it was weighted.
