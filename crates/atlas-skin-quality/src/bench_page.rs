@@ -275,10 +275,9 @@ fn skin_report(
          vertices overall ({}); {} of {} characters have some (goal: 0 on every character). \
          The count is of welded surface vertices (coincident vertices count once) plus stored \
          vertices no triangle uses, over the stored vertices, as issue 12 counts it: vertices \
-         of decomposed pieces that no region reaches and of pieces bound vertex by vertex to \
-         their nearest bone (the report's `pieces`: treatment `bones`); pieces made rigid, \
-         attached to the body surface or bent at the planes of the joints they hold \
-         (treatment `joints`) are not a fallback (docs/pieces.md).",
+         of decomposed pieces that no region reaches; pieces made rigid, attached to the \
+         body surface or bent at the planes of their joints (the report's `pieces`) are not \
+         a fallback (docs/pieces.md).",
         percent(average(&shares).unwrap_or(0.0)),
         fallback,
         vertices,

@@ -134,7 +134,7 @@ fn head_eyeballs_and_hat_move_rigidly_with_the_head_joint() {
         }
     }
     let counts = &skinned.counts.weights;
-    assert_eq!(counts.from_bone, 0, "no piece bound vertex by vertex");
+    assert_eq!(counts.bent, 0, "no piece bent at joints");
     assert_eq!(
         counts.rigid,
         pieces.part("head").count() + pieces.part("eye").count() + pieces.part("hat").count()

@@ -549,7 +549,7 @@ fn vertices_no_region_with_joints_reaches_take_the_nearest_weights() {
     assert_partition_of_unity(&weights);
     // The tetrahedron spans no joint: rigid to the bone it sits by; the top bar, a region
     // of a decomposed piece, takes its weights along the piece (the fallback).
-    assert_eq!((counts.rigid, counts.from_bone, counts.attached), (4, 0, 0));
+    assert_eq!((counts.rigid, counts.bent, counts.attached), (4, 0, 0));
     assert!(counts.from_surface > 50, "{counts:?}");
     assert_eq!(counts.unreachable, counts.rigid + counts.from_surface);
     let treatments: Vec<PieceTreatment> = counts.pieces.iter().map(|p| p.treatment).collect();

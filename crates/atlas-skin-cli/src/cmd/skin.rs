@@ -273,13 +273,6 @@ fn report(
             weight_counts.from_surface
         ));
     }
-    if weight_counts.from_bone > 0 {
-        warnings.push(format!(
-            "fallback: {} vertices lie in pieces that span a joint with no cut and no body \
-             beneath: each is bound to its nearest bone",
-            weight_counts.from_bone
-        ));
-    }
     if !weight_counts.inactive_soft_joints.is_empty() {
         let names: Vec<&str> = weight_counts
             .inactive_soft_joints
@@ -309,7 +302,7 @@ fn report(
             "joints": counts.joints,
             "regions": decomposition.regions.len(),
             "unreachable_vertices": weight_counts.unreachable,
-            "fallback_weighted_vertices": weight_counts.from_surface + weight_counts.from_bone
+            "fallback_weighted_vertices": weight_counts.from_surface
                 + counts.unreferenced_stored_vertices,
             "max_influences": skinned.weights.max_influences(),
             "leaf_patches": weight_counts.leaf_patches.len(),
@@ -323,7 +316,7 @@ fn report(
 }
 
 /// How the pieces were weighted: per treatment the number of pieces and vertices, and
-/// every piece that was not decomposed (`attached`, `rigid` with its joint, `bones`).
+/// every piece that was not decomposed (`attached`, `rigid` with its joint, `joints`).
 fn pieces_report(decomposition: &Decomposition, counts: &WeightCounts) -> Value {
     let mut summary = serde_json::Map::new();
     let mut loose = Vec::new();
@@ -332,7 +325,6 @@ fn pieces_report(decomposition: &Decomposition, counts: &WeightCounts) -> Value 
             PieceTreatment::Body => ("body", None),
             PieceTreatment::Attached => ("attached", None),
             PieceTreatment::Rigid(j) => ("rigid", Some(j)),
-            PieceTreatment::Bones => ("bones", None),
             PieceTreatment::Joints => ("joints", None),
         };
         let entry = summary

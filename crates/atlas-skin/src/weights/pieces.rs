@@ -23,17 +23,15 @@
 //!    where the body under it bends.
 //! 3. **rigid** to J when the piece is small next to J's bone: its bounding-box diagonal
 //!    is at most L_J, the length of J's longest bone segment.
-//! 4. **joints** otherwise, when the piece holds bones: it spans a joint with no body
-//!    beneath and no cut of its own (an arm modelled apart from the torso), and bends at
-//!    the boundary planes of the joints it holds ([`HeldJoints`]), with the transition of
-//!    §4 across each plane: for a vertex p whose nearest held bone is J's, the weight
-//!    flows from the root of J's chain among the held joints down to J, each joint c on
-//!    the way passing on the share s_c(p) = β(clamp((w_c + n_c·(p − o_c)) / (2 w_c), 0,
-//!    1)) of its boundary (plane point o_c, normal n_c to the child side, half-width w_c
-//!    of [`crate::overlap`]); J passes s_c(p) on to each held child with a boundary.
-//! 5. **bones** otherwise (a piece that holds no bone, spans a joint, and neither sits on
-//!    the body nor is small): every vertex is bound to its nearest bone J(p), so that it
-//!    bends at that joint. The report counts these vertices as a fallback and warns.
+//! 4. **joints** otherwise: the piece spans a joint with no body beneath and no cut of its
+//!    own (an arm modelled apart from the torso, an open sleeve) and bends at the boundary
+//!    planes of the joints it holds, or, holding none, of the joints of its vertices'
+//!    nearest bones ([`HeldJoints`]), with the transition of §4 across each plane: for a
+//!    vertex p whose nearest of those bones is J's, the weight flows from the root of J's
+//!    chain among those joints down to J, each joint c on the way passing on the share
+//!    s_c(p) = β(clamp((w_c + n_c·(p − o_c)) / (2 w_c), 0, 1)) of its boundary (plane
+//!    point o_c, normal n_c to the child side, half-width w_c of [`crate::overlap`]); J
+//!    passes s_c(p) on to each of its children among them that has a boundary.
 //!
 //! Measured on the 64 scored characters of `../shared/data/bench` (docs/pieces.md):
 //! attaching every piece whose vertices are mostly nearer to S than to a bone raised the
@@ -46,7 +44,8 @@
 //! 10.5% to 4.6% (21 characters better on the mean, 3 worse). Bending the pieces that hold
 //! bones at their joints' planes instead of binding each vertex to its nearest held bone:
 //! averages unchanged (3 characters better on the mean, 3 worse, all within 3%), fallback
-//! share 4.6% to 2.2%.
+//! share 4.6% to 2.2%; bending the pieces that hold none at the joints of their vertices'
+//! nearest bones likewise: .0088 / .184 to .0088 / .183, fallback share 2.2% to 0.9%.
 //!
 //! Inside a body piece, a vertex no region with joints reaches (a region without joints
 //! beside cut ones) copies the weights of the nearest weighted vertex along the piece's
@@ -116,33 +115,37 @@ pub fn weight_pieces(
     if !loose.is_empty() {
         let body = BodySurface::new(surface, &decomposition.face_region, decomposition, weights);
         let segments = bone_segments(skeleton);
+        let loose: Vec<usize> = if segments.is_empty() {
+            Vec::new()
+        } else {
+            loose
+        };
         let mut faces: Vec<Vec<[u32; 3]>> = vec![Vec::new(); piece_count];
         for t in &surface.triangles {
             faces[piece_of[t[0] as usize] as usize].push(*t);
         }
+        let planes = boundary_planes(decomposition, overlaps);
+        let loose_piece = LoosePiece {
+            surface,
+            body: &body,
+            weights,
+            skeleton,
+            planes: &planes,
+        };
         let weighted: Vec<(PieceTreatment, Vec<Row>)> = loose
             .par_iter()
             .map(|&c| {
                 let held = held_bones(surface, &members[c], &faces[c], &segments);
                 let candidates = if held.is_empty() { &segments } else { &held };
-                let weighted = weight_loose_piece(surface, &members[c], &body, weights, candidates);
-                if weighted.0 == PieceTreatment::Bones && !held.is_empty() {
-                    let bend = HeldJoints::new(decomposition, skeleton, overlaps, &held);
-                    let rows = members[c]
-                        .iter()
-                        .map(|&v| bend.row(surface.positions[v as usize], &held))
-                        .collect();
-                    return (PieceTreatment::Joints, rows);
-                }
-                weighted
+                loose_piece.weight(&members[c], candidates, !held.is_empty())
             })
             .collect();
         for (&c, (treatment, piece_rows)) in loose.iter().zip(weighted) {
             match treatment {
                 PieceTreatment::Attached => counts.attached += members[c].len(),
                 PieceTreatment::Rigid(_) => counts.rigid += members[c].len(),
-                PieceTreatment::Bones => counts.from_bone += members[c].len(),
-                PieceTreatment::Body | PieceTreatment::Joints => {}
+                PieceTreatment::Joints => counts.bent += members[c].len(),
+                PieceTreatment::Body => {}
             }
             pieces[c].treatment = treatment;
             for (&v, row) in members[c].iter().zip(piece_rows) {
@@ -255,54 +258,72 @@ struct BodyPoint {
 /// A row of (joint, weight) pairs.
 type Row = Vec<(u32, f64)>;
 
-/// Weights one piece without joints (module documentation): how, and the row of each of
-/// `vertices`. The body surface is asked only when the nearest bones are not unanimous.
-fn weight_loose_piece(
-    surface: &SurfaceMesh,
-    vertices: &[u32],
-    body: &BodySurface,
-    weights: &SurfaceWeights,
-    segments: &[(u32, DVec3, DVec3)],
-) -> (PieceTreatment, Vec<Row>) {
-    let position = |v: u32| surface.positions[v as usize];
-    let bones: Vec<Option<NearestBone>> = vertices
-        .par_iter()
-        .map(|&v| nearest_bone_with_distance(segments, position(v)))
-        .collect();
-    let joints: Vec<Option<u32>> = bones.iter().map(|b| b.map(|b| b.joint)).collect();
-    let rigid = |joint: u32| {
-        (
-            PieceTreatment::Rigid(joint),
-            vec![vec![(joint, 1.0)]; vertices.len()],
-        )
-    };
-    let Some(dominant) = most_frequent(&joints) else {
-        return (PieceTreatment::Bones, vec![Row::new(); vertices.len()]);
-    };
-    if joints.iter().all(|&j| j == Some(dominant)) {
-        return rigid(dominant);
+/// What weighting a piece without joints needs besides the piece.
+struct LoosePiece<'a> {
+    surface: &'a SurfaceMesh,
+    body: &'a BodySurface,
+    weights: &'a SurfaceWeights,
+    skeleton: &'a Skeleton,
+    planes: &'a [Option<Plane>],
+}
+
+impl LoosePiece<'_> {
+    /// Weights one piece without joints (module documentation): how, and the row of each
+    /// of `vertices`. `candidates` (not empty): the bones it holds when `holds`, else every
+    /// bone. The body surface is asked only when the nearest bones are not unanimous.
+    fn weight(
+        &self,
+        vertices: &[u32],
+        candidates: &[(u32, DVec3, DVec3)],
+        holds: bool,
+    ) -> (PieceTreatment, Vec<Row>) {
+        let position = |v: u32| self.surface.positions[v as usize];
+        let bones: Vec<Option<NearestBone>> = vertices
+            .par_iter()
+            .map(|&v| nearest_bone_with_distance(candidates, position(v)))
+            .collect();
+        let joints: Vec<Option<u32>> = bones.iter().map(|b| b.map(|b| b.joint)).collect();
+        let rigid = |joint: u32| {
+            (
+                PieceTreatment::Rigid(joint),
+                vec![vec![(joint, 1.0)]; vertices.len()],
+            )
+        };
+        let dominant = most_frequent(&joints).unwrap_or(candidates[0].0);
+        if joints.iter().all(|&j| j == Some(dominant)) {
+            return rigid(dominant);
+        }
+        let on_body: Option<Vec<Row>> = vertices
+            .par_iter()
+            .zip(&bones)
+            .map(|(&v, bone)| {
+                let at = self.body.weights_at(self.weights, position(v))?;
+                (at.distance < bone.map_or(f64::INFINITY, |b| b.distance)).then_some(at.row)
+            })
+            .collect();
+        if let Some(rows) = on_body {
+            return (PieceTreatment::Attached, rows);
+        }
+        let positions: Vec<DVec3> = vertices.iter().map(|&v| position(v)).collect();
+        let (lo, hi) = crate::geometry::bounding_box(&positions);
+        if (hi - lo).length() <= longest_bone(candidates, dominant) {
+            return rigid(dominant);
+        }
+        // Bent at the joints it holds or, holding none, at the joints of its vertices'
+        // nearest bones.
+        let bending: Vec<(u32, DVec3, DVec3)> = if holds {
+            candidates.to_vec()
+        } else {
+            candidates
+                .iter()
+                .filter(|s| joints.contains(&Some(s.0)))
+                .copied()
+                .collect()
+        };
+        let bend = HeldJoints::new(self.skeleton, self.planes, &bending);
+        let rows = positions.iter().map(|&p| bend.row(p, &bending)).collect();
+        (PieceTreatment::Joints, rows)
     }
-    let on_body: Option<Vec<Row>> = vertices
-        .par_iter()
-        .zip(&bones)
-        .map(|(&v, bone)| {
-            let at = body.weights_at(weights, position(v))?;
-            (at.distance < bone.map_or(f64::INFINITY, |b| b.distance)).then_some(at.row)
-        })
-        .collect();
-    if let Some(rows) = on_body {
-        return (PieceTreatment::Attached, rows);
-    }
-    let positions: Vec<DVec3> = vertices.iter().map(|&v| position(v)).collect();
-    let (lo, hi) = crate::geometry::bounding_box(&positions);
-    if (hi - lo).length() <= longest_bone(segments, dominant) {
-        return rigid(dominant);
-    }
-    let rows = joints
-        .into_iter()
-        .map(|j| j.map(|j| (j, 1.0)).into_iter().collect())
-        .collect();
-    (PieceTreatment::Bones, rows)
 }
 
 /// How many points along a bone segment are tested against a piece ([`held_bones`]).
@@ -360,18 +381,29 @@ struct HeldJoints {
     joints: Vec<u32>,
     /// Nearest held ancestor of each held joint.
     parent: Vec<Option<u32>>,
-    /// Boundary plane (point, unit normal to the child side) and half-width of each held
-    /// joint that has a boundary.
-    plane: Vec<Option<(DVec3, DVec3, f64)>>,
+    /// Boundary plane of each held joint that has a boundary.
+    plane: Vec<Option<Plane>>,
+}
+
+/// A joint's boundary plane: a point, the unit normal to the child side, the overlap
+/// half-width.
+type Plane = (DVec3, DVec3, f64);
+
+/// The boundary plane of every joint that has a boundary (#J).
+fn boundary_planes(decomposition: &Decomposition, overlaps: &Overlaps) -> Vec<Option<Plane>> {
+    decomposition
+        .joints
+        .iter()
+        .map(|decision| {
+            let k = decision.boundary? as usize;
+            let boundary = &decomposition.boundaries[k];
+            Some((boundary.point, boundary.normal, overlaps.half_widths[k]))
+        })
+        .collect()
 }
 
 impl HeldJoints {
-    fn new(
-        decomposition: &Decomposition,
-        skeleton: &Skeleton,
-        overlaps: &Overlaps,
-        held: &[(u32, DVec3, DVec3)],
-    ) -> Self {
+    fn new(skeleton: &Skeleton, planes: &[Option<Plane>], held: &[(u32, DVec3, DVec3)]) -> Self {
         let mut joints: Vec<u32> = held.iter().map(|s| s.0).collect();
         joints.sort_unstable();
         joints.dedup();
@@ -384,14 +416,7 @@ impl HeldJoints {
                     .find(|a| joints.binary_search(a).is_ok())
             })
             .collect();
-        let plane = joints
-            .iter()
-            .map(|&j| {
-                let k = decomposition.joints[j as usize].boundary? as usize;
-                let boundary = &decomposition.boundaries[k];
-                Some((boundary.point, boundary.normal, overlaps.half_widths[k]))
-            })
-            .collect();
+        let plane = joints.iter().map(|&j| planes[j as usize]).collect();
         Self {
             joints,
             parent,

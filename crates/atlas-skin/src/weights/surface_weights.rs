@@ -45,9 +45,9 @@ pub struct WeightCounts {
     /// Of those, vertices of decomposed pieces weighted from the nearest weighted vertex
     /// along their piece's edges (the fallback).
     pub from_surface: usize,
-    /// Of those, vertices of pieces that span a joint with no body beneath, bound to their
-    /// nearest bone.
-    pub from_bone: usize,
+    /// Of those, vertices of pieces that span a joint with no body beneath, bent at the
+    /// boundary planes of their joints.
+    pub bent: usize,
     /// Of those, vertices of pieces attached to the body surface they sit on.
     pub attached: usize,
     /// Of those, vertices of pieces bound rigidly to one joint.
@@ -72,9 +72,8 @@ pub enum PieceTreatment {
     Attached,
     /// Weight 1 on one joint.
     Rigid(u32),
-    /// Every vertex bound to its nearest bone.
-    Bones,
-    /// Bent at the boundary planes of the joints whose bones it holds.
+    /// Bent at the boundary planes of the joints whose bones it holds (or, holding none,
+    /// of its vertices' nearest bones).
     Joints,
 }
 
