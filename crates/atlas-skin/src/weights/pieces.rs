@@ -12,7 +12,8 @@
 //! bone segment nearest to p and d_B(p) the distance to it
 //! ([`crate::skeleton::bones`]), J the most frequent J(p) over the piece, d_S(p) the
 //! distance from p to the body surface S (the faces of body regions whose three corners
-//! have weights), in this order:
+//! have weights; for a piece that holds no bone, also the faces of the pieces that hold
+//! bones, weighted first: a hat sits on a head piece), in this order:
 //!
 //! 1. **rigid** to J when every J(p) = J: no joint's bisecting surface passes through the
 //!    piece (eyes, buttons, armour plates, hats); every vertex gets weight 1 on J.
@@ -46,6 +47,9 @@
 //! averages unchanged (3 characters better on the mean, 3 worse, all within 3%), fallback
 //! share 4.6% to 2.2%; bending the pieces that hold none at the joints of their vertices'
 //! nearest bones likewise: .0088 / .184 to .0088 / .183, fallback share 2.2% to 0.9%.
+//! Weighting the pieces that hold bones first and letting the others sit on them too:
+//! .0088 / .183 to .0084 / .176 (17 characters better on the mean, 6 worse; KayKit's
+//! helmets and hoods now move with the head piece they sit on).
 //!
 //! Inside a body piece, a vertex no region with joints reaches (a region without joints
 //! beside cut ones) copies the weights of the nearest weighted vertex along the piece's
@@ -111,36 +115,53 @@ pub fn weight_pieces(
 
     let mut rows: Vec<Option<Row>> = vec![None; n];
     fill_body_gaps(decomposition, weights, &empty, &mut rows, &mut counts);
-    let loose: Vec<usize> = (0..piece_count).filter(|&c| !is_body[c]).collect();
-    if !loose.is_empty() {
-        let body = BodySurface::new(surface, &decomposition.face_region, decomposition, weights);
-        let segments = bone_segments(skeleton);
-        let loose: Vec<usize> = if segments.is_empty() {
-            Vec::new()
-        } else {
-            loose
-        };
-        let mut faces: Vec<Vec<[u32; 3]>> = vec![Vec::new(); piece_count];
-        for t in &surface.triangles {
-            faces[piece_of[t[0] as usize] as usize].push(*t);
+    let segments = bone_segments(skeleton);
+    let loose: Vec<usize> = (0..piece_count)
+        .filter(|&c| !is_body[c] && !segments.is_empty())
+        .collect();
+    let mut faces: Vec<Vec<[u32; 3]>> = vec![Vec::new(); piece_count];
+    for t in &surface.triangles {
+        faces[piece_of[t[0] as usize] as usize].push(*t);
+    }
+    let held: Vec<Vec<(u32, DVec3, DVec3)>> = loose
+        .par_iter()
+        .map(|&c| held_bones(surface, &members[c], &faces[c], &segments))
+        .collect();
+    let planes = boundary_planes(decomposition, overlaps);
+    // Pieces that hold bones first, on the body surface; then the pieces that hold none,
+    // on the body surface and the pieces of the first pass (a hat sits on a head piece).
+    let mut body_faces: Vec<[u32; 3]> = surface
+        .triangles
+        .iter()
+        .zip(&decomposition.face_region)
+        .filter(|(_, &r)| !decomposition.regions[r as usize].joints.is_empty())
+        .map(|(t, _)| *t)
+        .collect();
+    let mut current = weights.clone();
+    for holding in [true, false] {
+        let pass: Vec<usize> = (0..loose.len())
+            .filter(|&k| held[k].is_empty() != holding)
+            .collect();
+        if pass.is_empty() {
+            continue;
         }
-        let planes = boundary_planes(decomposition, overlaps);
+        let body = BodySurface::new(surface, &body_faces, &current);
         let loose_piece = LoosePiece {
             surface,
             body: &body,
-            weights,
+            weights: &current,
             skeleton,
             planes: &planes,
         };
-        let weighted: Vec<(PieceTreatment, Vec<Row>)> = loose
+        let weighted: Vec<(PieceTreatment, Vec<Row>)> = pass
             .par_iter()
-            .map(|&c| {
-                let held = held_bones(surface, &members[c], &faces[c], &segments);
-                let candidates = if held.is_empty() { &segments } else { &held };
-                loose_piece.weight(&members[c], candidates, !held.is_empty())
+            .map(|&k| {
+                let candidates = if holding { &held[k] } else { &segments };
+                loose_piece.weight(&members[loose[k]], candidates, holding)
             })
             .collect();
-        for (&c, (treatment, piece_rows)) in loose.iter().zip(weighted) {
+        for (&k, (treatment, piece_rows)) in pass.iter().zip(weighted) {
+            let c = loose[k];
             match treatment {
                 PieceTreatment::Attached => counts.attached += members[c].len(),
                 PieceTreatment::Rigid(_) => counts.rigid += members[c].len(),
@@ -151,21 +172,28 @@ pub fn weight_pieces(
             for (&v, row) in members[c].iter().zip(piece_rows) {
                 rows[v as usize] = Some(row);
             }
+            body_faces.extend_from_slice(&faces[c]);
         }
+        current = with_rows(weights, &rows);
     }
-    let mut filled = SurfaceWeights {
+    *weights = with_rows(weights, &rows);
+    counts.pieces = pieces;
+    counts
+}
+
+/// `weights` with the rows of `rows` where they are given.
+fn with_rows(weights: &SurfaceWeights, rows: &[Option<Row>]) -> SurfaceWeights {
+    let mut result = SurfaceWeights {
         offsets: vec![0],
         ..SurfaceWeights::default()
     };
-    for (v, row) in rows.into_iter().enumerate() {
+    for (v, row) in rows.iter().enumerate() {
         match row {
-            Some(row) => filled.extend_row(row),
-            None => filled.extend_row(weights.row(v)),
+            Some(row) => result.extend_row(row.iter().copied()),
+            None => result.extend_row(weights.row(v)),
         }
     }
-    *weights = filled;
-    counts.pieces = pieces;
-    counts
+    result
 }
 
 /// The fallback inside body pieces: every vertex without weights in a piece that has
@@ -202,22 +230,13 @@ struct BodySurface {
 }
 
 impl BodySurface {
-    fn new(
-        surface: &SurfaceMesh,
-        face_region: &[u32],
-        decomposition: &Decomposition,
-        weights: &SurfaceWeights,
-    ) -> Self {
+    /// The faces of `triangles` whose three corners have weights, indexed.
+    fn new(surface: &SurfaceMesh, triangles: &[[u32; 3]], weights: &SurfaceWeights) -> Self {
         let weighted = |v: u32| weights.offsets[v as usize] != weights.offsets[v as usize + 1];
-        let triangles: Vec<[u32; 3]> = surface
-            .triangles
+        let triangles: Vec<[u32; 3]> = triangles
             .iter()
-            .zip(face_region)
-            .filter(|(t, &r)| {
-                !decomposition.regions[r as usize].joints.is_empty()
-                    && t.iter().all(|&v| weighted(v))
-            })
-            .map(|(t, _)| *t)
+            .filter(|t| t.iter().all(|&v| weighted(v)))
+            .copied()
             .collect();
         let mesh = SurfaceMesh {
             positions: surface.positions.clone(),
