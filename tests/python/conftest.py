@@ -30,3 +30,12 @@ def cli():
         return subprocess.run([str(binary), *map(str, args)], capture_output=True, text=True, check=check)
 
     return run
+
+
+@pytest.fixture(scope="session")
+def demo():
+    """The demo character's arrays (generated once: about 2 s of CPU). Tests copy before
+    changing them."""
+    import atlas_skin
+
+    return atlas_skin.demo()

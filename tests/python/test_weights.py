@@ -40,9 +40,9 @@ def assert_same_as_cli(character, skinned_glb, **options):
     return indices, weights, report
 
 
-def test_demo_weights_equal_the_cli(cli, tmp_path):
+def test_demo_weights_equal_the_cli(cli, demo, tmp_path):
     cli("skin", "-o", tmp_path / "demo.glb")
-    indices, weights, report = assert_same_as_cli(atlas_skin.demo(), tmp_path / "demo.glb")
+    indices, weights, report = assert_same_as_cli(demo, tmp_path / "demo.glb")
     assert indices.dtype == np.uint32 and weights.dtype == np.float32
     assert indices.shape == weights.shape == (16000, 4)
     np.testing.assert_allclose(weights.sum(axis=1), 1.0, atol=1e-6)
@@ -57,9 +57,8 @@ def test_corpus_weights_equal_the_cli(cli, tmp_path, relative):
     assert_same_as_cli(atlas_skin.load(source), tmp_path / "out.glb")
 
 
-def test_options_reach_the_method(cli, tmp_path):
+def test_options_reach_the_method(cli, demo, tmp_path):
     """max_influences, overlap, blend and forbid as the CLI's flags."""
-    demo = atlas_skin.demo()
     args = ["--max-influences", "2", "--overlap", "0.3", "--blend", "paper", "--forbid", demo["names"][3]]
     cli("skin", "-o", tmp_path / "demo.glb", *args)
     indices, weights, report = assert_same_as_cli(
@@ -70,8 +69,7 @@ def test_options_reach_the_method(cli, tmp_path):
     assert not np.array_equal(dense(indices, weights, 35), dense(default_indices, default_weights, 35))
 
 
-def test_float64_and_int64_inputs_give_the_same_weights():
-    demo = atlas_skin.demo()
+def test_float64_and_int64_inputs_give_the_same_weights(demo):
     a = atlas_skin.compute_weights(demo["positions"], demo["triangles"], demo["joint_positions"], demo["parents"])
     b = atlas_skin.compute_weights(
         demo["positions"].astype(np.float64),

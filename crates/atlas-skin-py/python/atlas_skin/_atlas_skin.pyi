@@ -31,7 +31,7 @@ class MethodOptions(TypedDict, total=False):
       (``--force``).
     - ``forbid``: joint names given no boundary: their part moves with the parent's
       (``--forbid``).
-    - ``max_influences``: influences kept per vertex, the largest, renormalised (1..=8,
+    - ``max_influences``: influences kept per vertex, the largest, renormalised (1..=32,
       default 4) (``--max-influences``).
     - ``config``: a settings file (``--config``: JSON, any subset of ``decompose``,
       ``overlap`` {``factor``, ``per_joint``}, ``blend``, ``max_influences``), which the
