@@ -45,5 +45,5 @@ def test_batch_skins_every_file_and_records_the_failures(tmp_path):
 def test_batch_that_cannot_start(tmp_path):
     with pytest.raises(ValueError, match="matches no file"):
         atlas_skin.batch([str(tmp_path / "*.glb")], tmp_path / "out")
-    with pytest.raises(ValueError, match="jobs must be at least 1"):
+    with pytest.raises(ValueError, match=r"jobs 0 is outside 1..=256"):
         atlas_skin.batch([data("bench/kaykit/Knight.glb")], tmp_path / "out", jobs=0)

@@ -22,6 +22,9 @@ use thiserror::Error;
 /// Extensions of the files taken from a folder: the formats that carry a skeleton.
 pub const CHARACTER_EXTENSIONS: [&str; 4] = ["glb", "gltf", "vrm", "fbx"];
 
+/// Most files skinned at the same time.
+pub const MAX_JOBS: usize = 256;
+
 /// The log's name in the output folder when none is given.
 pub const DEFAULT_LOG_NAME: &str = "atlas-skin-batch.jsonl";
 
@@ -54,6 +57,8 @@ pub enum BatchError {
     },
     #[error(transparent)]
     Log(#[from] IoError),
+    #[error("jobs {jobs} is outside 1..={MAX_JOBS}")]
+    Jobs { jobs: usize },
     #[error("cannot start {jobs} threads")]
     Threads {
         jobs: usize,
@@ -67,7 +72,7 @@ pub enum BatchError {
 pub struct BatchOptions {
     /// Where `<name>.glb` (and `.json`, `.html`) go; created when missing.
     pub out_dir: PathBuf,
-    /// Files skinned at the same time (at least 1).
+    /// Files skinned at the same time, `1..=`[`MAX_JOBS`].
     pub jobs: usize,
     /// Skip the files whose outputs exist and are newer than the file and the settings.
     pub resume: bool,
@@ -105,9 +110,10 @@ pub enum Status {
 /// One line of the log.
 #[derive(Debug, Clone, Serialize)]
 pub struct Record {
-    pub input: PathBuf,
+    /// The input's path, as given (not valid UTF-8: lossily converted).
+    pub input: String,
     /// The skinned glb (written, or the one that was up to date).
-    pub output: PathBuf,
+    pub output: String,
     pub status: Status,
     /// The message `skin` would print, for a failed file.
     pub error: Option<String>,
@@ -284,8 +290,14 @@ fn up_to_date(job: &SkinJob) -> bool {
 fn run_one(job: &SkinJob, resume: bool) -> Record {
     let start = Instant::now();
     let mut record = Record {
-        input: job.input.path.clone().unwrap_or_default(),
-        output: job.outputs.glb.clone(),
+        input: job
+            .input
+            .path
+            .as_deref()
+            .unwrap_or(Path::new(""))
+            .to_string_lossy()
+            .into_owned(),
+        output: job.outputs.glb.to_string_lossy().into_owned(),
         status: Status::Skipped,
         error: None,
         seconds: 0.0,
@@ -322,6 +334,9 @@ pub fn run_batch(
     on_record: &(dyn Fn(&Record) + Sync),
 ) -> Result<(Vec<Record>, Summary), BatchError> {
     let start = Instant::now();
+    if !(1..=MAX_JOBS).contains(&options.jobs) {
+        return Err(BatchError::Jobs { jobs: options.jobs });
+    }
     let log_path = options.log_path();
     let inputs: Vec<&Path> = jobs
         .iter()
@@ -339,7 +354,7 @@ pub fn run_batch(
     }
     let log = Mutex::new(std::fs::File::create(&log_path).map_err(log_error)?);
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(options.jobs.max(1))
+        .num_threads(options.jobs)
         .build()
         .map_err(|source| BatchError::Threads {
             jobs: options.jobs,
@@ -351,10 +366,10 @@ pub fn run_batch(
             .with_max_len(1)
             .map(|job| {
                 let record = run_one(job, options.resume);
-                let mut line = serde_json::to_string(&record).unwrap_or_default();
-                line.push('\n');
+                let mut line = serde_json::to_vec(&record).map_err(|e| log_error(e.into()))?;
+                line.push(b'\n');
                 let mut file = log.lock().unwrap_or_else(|e| e.into_inner());
-                file.write_all(line.as_bytes())
+                file.write_all(&line)
                     .and_then(|()| file.flush())
                     .map_err(log_error)?;
                 drop(file);

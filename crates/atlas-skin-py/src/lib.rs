@@ -379,9 +379,6 @@ fn batch<'py>(
         log,
         settings: method_settings(options)?,
     };
-    if options.jobs == 0 {
-        return Err(PyValueError::new_err("jobs must be at least 1"));
-    }
     let result = py.detach(|| {
         no_panic(|| {
             let refused = |e: BatchError| PyValueError::new_err(error_chain(&e));

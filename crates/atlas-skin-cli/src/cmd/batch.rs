@@ -21,7 +21,7 @@ pub struct Args {
     pub out_dir: PathBuf,
     /// Files skinned at the same time [default: the number of cores].
     #[arg(short, long, value_name = "N",
-          value_parser = crate::counts::count_between(1, crate::counts::MAX_THREADS))]
+          value_parser = crate::counts::count_between(1, atlas_skin_job::batch::MAX_JOBS))]
     pub jobs: Option<usize>,
     /// Skip the files whose outputs exist and are newer than the file (and --config).
     #[arg(long)]
