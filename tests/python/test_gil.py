@@ -41,6 +41,8 @@ def test_a_thread_keeps_running_while_compute_weights_works(demo):
     stop.set()
     thread.join()
     # Held, the GIL would let the thread count only in the few milliseconds of
-    # argument conversion; released, it counts at a good share of its own pace.
+    # argument conversion; released, it counts at a good share of its own pace. Measured on
+    # the 2-core machine at a load of 9: 0.37-0.64 of its pace during compute_weights,
+    # 0.01-0.06 during a C call that holds the GIL (sorted() of 2M floats).
     expected = alone * elapsed / call_seconds
-    assert during > 0.25 * expected, (during, expected)
+    assert during > 0.2 * expected, (during, expected)

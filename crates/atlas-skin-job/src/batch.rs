@@ -392,3 +392,63 @@ pub fn run_batch(
     };
     Ok((records, summary))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A fresh folder under the system's temporary folder.
+    fn scratch(name: &str) -> PathBuf {
+        let dir =
+            std::env::temp_dir().join(format!("atlas-skin-job-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(dir.join("sub")).unwrap();
+        dir
+    }
+
+    #[test]
+    fn folders_give_their_character_files_sorted_and_each_file_once() {
+        let dir = scratch("collect");
+        for name in ["b.glb", "a.FBX", "sub/c.vrm", "notes.txt", "mesh.obj"] {
+            std::fs::write(dir.join(name), b"").unwrap();
+        }
+        let files = collect_inputs(&[dir.clone(), dir.join("b.glb")]).unwrap();
+        let names: Vec<PathBuf> = files
+            .iter()
+            .map(|f| f.strip_prefix(&dir).unwrap().to_path_buf())
+            .collect();
+        assert_eq!(names, ["a.FBX", "b.glb", "sub/c.vrm"].map(PathBuf::from));
+        let pattern = dir.join("*.glb");
+        assert_eq!(collect_inputs(&[pattern]).unwrap(), [dir.join("b.glb")]);
+        let missing = dir.join("missing.glb");
+        assert_eq!(collect_inputs(&[missing.clone()]).unwrap(), [missing]);
+        assert!(matches!(
+            collect_inputs(&[dir.join("*.fbx")]),
+            Err(BatchError::NoMatch { .. })
+        ));
+        assert!(matches!(collect_inputs(&[]), Err(BatchError::NoInputs)));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn outputs_are_named_after_the_inputs_and_clashes_refused() {
+        let options = BatchOptions {
+            out_dir: PathBuf::from("out"),
+            jobs: 1,
+            report: true,
+            ..BatchOptions::default()
+        };
+        let jobs = plan_jobs(&[PathBuf::from("a/knight.fbx")], &options).unwrap();
+        assert_eq!(jobs[0].outputs.glb, Path::new("out/knight.glb"));
+        assert_eq!(
+            jobs[0].outputs.report.as_deref(),
+            Some(Path::new("out/knight.json"))
+        );
+        assert_eq!(jobs[0].outputs.html, None);
+        let clash = plan_jobs(
+            &[PathBuf::from("a/knight.fbx"), PathBuf::from("b/knight.glb")],
+            &options,
+        );
+        assert!(matches!(clash, Err(BatchError::NameClash { .. })));
+    }
+}
