@@ -421,7 +421,10 @@ mod tests {
         let pattern = dir.join("*.glb");
         assert_eq!(collect_inputs(&[pattern]).unwrap(), [dir.join("b.glb")]);
         let missing = dir.join("missing.glb");
-        assert_eq!(collect_inputs(&[missing.clone()]).unwrap(), [missing]);
+        assert_eq!(
+            collect_inputs(std::slice::from_ref(&missing)).unwrap(),
+            [missing]
+        );
         assert!(matches!(
             collect_inputs(&[dir.join("*.fbx")]),
             Err(BatchError::NoMatch { .. })
