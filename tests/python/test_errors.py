@@ -52,6 +52,11 @@ def test_values_that_are_not_finite(demo):
         weights(demo, tails=tails)
 
 
+def test_a_skeleton_without_joints(demo):
+    with pytest.raises(ValueError, match="joint_positions is empty: a skeleton needs at least one joint"):
+        weights(demo, joint_positions=np.zeros((0, 3)), parents=np.zeros(0, np.int64))
+
+
 def test_indices_out_of_range(demo):
     triangles = demo["triangles"].astype(np.int64)
     triangles[5, 2] = 16000

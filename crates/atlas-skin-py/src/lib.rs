@@ -92,6 +92,11 @@ fn skeleton_from_arrays(
 ) -> PyResult<Skeleton> {
     let positions = arrays::points(joint_positions, "joint_positions", 'J')?;
     let count = positions.len();
+    if count == 0 {
+        return Err(PyValueError::new_err(
+            "joint_positions is empty: a skeleton needs at least one joint",
+        ));
+    }
     let parents = arrays::parents(parents, count)?;
     let names = match names {
         Some(names) if names.len() != count => {
