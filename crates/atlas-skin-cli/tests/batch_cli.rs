@@ -281,7 +281,7 @@ fn resume_redoes_a_file_newer_than_its_output() {
         "--resume".as_ref(),
     ]);
     assert!(
-        stdout.contains("1 files: 1 skinned, 0 failed, 0 up to date"),
+        stdout.contains("1 file: 1 skinned, 0 failed, 0 up to date"),
         "{stdout}"
     );
     // Asking for a report the first run did not write also redoes the file.

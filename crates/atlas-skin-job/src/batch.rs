@@ -152,8 +152,9 @@ impl std::fmt::Display for Summary {
         }
         write!(
             f,
-            "{} files: {} skinned, {} failed, {} up to date, in {:.1} s ({:.2} characters/s); log: {}",
+            "{} file{}: {} skinned, {} failed, {} up to date, in {:.1} s ({:.2} characters/s); log: {}",
             self.files,
+            if self.files == 1 { "" } else { "s" },
             self.ok,
             self.failed,
             self.skipped,
