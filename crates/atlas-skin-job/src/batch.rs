@@ -15,6 +15,7 @@ use serde_json::Value;
 use std::collections::HashMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 use std::time::{Instant, SystemTime};
 use thiserror::Error;
@@ -105,6 +106,8 @@ pub enum Status {
     Failed,
     /// Its outputs were up to date (`resume`).
     Skipped,
+    /// Not started: the batch was stopped (see [`run_batch`]'s `stop`).
+    Cancelled,
 }
 
 /// One line of the log.
@@ -134,6 +137,7 @@ pub struct Summary {
     pub ok: usize,
     pub failed: usize,
     pub skipped: usize,
+    pub cancelled: usize,
     /// Wall time of the batch, in seconds.
     pub seconds: f64,
     /// Skinned files per second of wall time.
@@ -143,16 +147,20 @@ pub struct Summary {
 
 impl std::fmt::Display for Summary {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        if self.ok == 0 && self.failed == 0 {
+        if self.ok == 0 && self.failed == 0 && self.cancelled == 0 {
             return write!(
                 f,
                 "nothing to do: the outputs of all {} files are up to date",
                 self.files
             );
         }
+        let cancelled = match self.cancelled {
+            0 => String::new(),
+            n => format!(", {n} cancelled"),
+        };
         write!(
             f,
-            "{} file{}: {} skinned, {} failed, {} up to date, in {:.1} s ({:.2} characters/s); log: {}",
+            "{} file{}: {} skinned, {} failed, {} up to date{cancelled}, in {:.1} s ({:.2} characters/s); log: {}",
             self.files,
             if self.files == 1 { "" } else { "s" },
             self.ok,
@@ -287,8 +295,8 @@ fn up_to_date(job: &SkinJob) -> bool {
     matches!((newest_input, oldest_output), (Some(i), Some(Some(o))) if o >= i)
 }
 
-/// Runs `job` and describes what happened.
-fn run_one(job: &SkinJob, resume: bool) -> Record {
+/// Runs `job` (unless `stop` is set) and describes what happened.
+fn run_one(job: &SkinJob, resume: bool, stop: &AtomicBool) -> Record {
     let start = Instant::now();
     let mut record = Record {
         input: job
@@ -306,6 +314,10 @@ fn run_one(job: &SkinJob, resume: bool) -> Record {
         counts: None,
         warnings: Vec::new(),
     };
+    if stop.load(Ordering::Relaxed) {
+        record.status = Status::Cancelled;
+        return record;
+    }
     if resume && up_to_date(job) {
         return record;
     }
@@ -328,11 +340,14 @@ fn run_one(job: &SkinJob, resume: bool) -> Record {
 
 /// Runs the batch: `jobs` ([`plan_jobs`]) on `options.jobs` threads; `on_record` is called
 /// with each record as its file finishes (from the worker threads), after the record is in
-/// the log. Returns every record, in the order of `jobs`, and the totals.
+/// the log. Once `stop` is set (by `on_record` or another thread), the files not yet
+/// started are not run: each is logged as [`Status::Cancelled`]; those running finish.
+/// Returns every record, in the order of `jobs`, and the totals.
 pub fn run_batch(
     jobs: &[SkinJob],
     options: &BatchOptions,
     on_record: &(dyn Fn(&Record) + Sync),
+    stop: &AtomicBool,
 ) -> Result<(Vec<Record>, Summary), BatchError> {
     let start = Instant::now();
     if !(1..=MAX_JOBS).contains(&options.jobs) {
@@ -366,7 +381,7 @@ pub fn run_batch(
         jobs.par_iter()
             .with_max_len(1)
             .map(|job| {
-                let record = run_one(job, options.resume);
+                let record = run_one(job, options.resume, stop);
                 let mut line = serde_json::to_vec(&record).map_err(|e| log_error(e.into()))?;
                 line.push(b'\n');
                 let mut file = log.lock().unwrap_or_else(|e| e.into_inner());
@@ -387,6 +402,7 @@ pub fn run_batch(
         ok: count(Status::Ok),
         failed: count(Status::Failed),
         skipped: count(Status::Skipped),
+        cancelled: count(Status::Cancelled),
         seconds,
         characters_per_second: count(Status::Ok) as f64 / seconds.max(1e-9),
         log: log_path,

@@ -12,7 +12,9 @@ use atlas_skin::pipeline::{skin, SkinInput};
 use atlas_skin::weights::blend::Blend;
 use atlas_skin_io::gltf::MAX_INFLUENCES;
 use atlas_skin_io::{Character, LoadOptions};
-use atlas_skin_job::batch::{collect_inputs, plan_jobs, run_batch, BatchError, BatchOptions};
+use atlas_skin_job::batch::{
+    collect_inputs, plan_jobs, run_batch, BatchError, BatchOptions, Record,
+};
 use atlas_skin_job::report::{skin_report, stage_timings};
 use atlas_skin_job::{error_chain, Input, JobError, Outputs, Settings, SkinJob};
 use atlas_skin_runtime::{reference, Skeleton, NO_PARENT};
@@ -23,6 +25,10 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use std::collections::{BTreeMap, HashSet};
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{self, RecvTimeoutError};
+use std::sync::Mutex;
+use std::time::Duration;
 
 /// How the input of `compute_weights` is named in messages and in the report.
 const ARRAYS_NAME: &str = "the given arrays";
@@ -358,7 +364,8 @@ fn skin_file<'py>(
 #[allow(clippy::too_many_arguments)]
 #[pyfunction]
 #[pyo3(signature = (
-    inputs, out_dir, *, jobs=None, resume=false, report=false, html=false, log=None, **options
+    inputs, out_dir, *, jobs=None, resume=false, report=false, html=false, log=None,
+    progress=None, **options
 ))]
 fn batch<'py>(
     py: Python<'py>,
@@ -369,6 +376,7 @@ fn batch<'py>(
     report: bool,
     html: bool,
     log: Option<PathBuf>,
+    progress: Option<Bound<'py, PyAny>>,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let inputs: Vec<PathBuf> = match inputs.extract::<PathBuf>() {
@@ -384,16 +392,66 @@ fn batch<'py>(
         log,
         settings: method_settings(options)?,
     };
-    let result = py.detach(|| {
+    let refused = |e: BatchError| PyValueError::new_err(error_chain(&e));
+    let jobs = py.detach(|| {
         no_panic(|| {
-            let refused = |e: BatchError| PyValueError::new_err(error_chain(&e));
             let files = collect_inputs(&inputs).map_err(refused)?;
-            let jobs = plan_jobs(&files, &options).map_err(refused)?;
-            let (records, summary) = run_batch(&jobs, &options, &|_| {}).map_err(refused)?;
-            Ok(serde_json::json!({"records": records, "summary": summary}))
+            plan_jobs(&files, &options).map_err(refused)
         })
     })?;
-    json_object(py, &result)
+    // The batch runs on a thread of its own; this thread passes each finished record to
+    // `progress` and checks for signals (Ctrl-C) meanwhile, stopping the batch on an
+    // exception from either.
+    let stop = AtomicBool::new(false);
+    let (sender, receiver) = mpsc::channel::<Record>();
+    // A receiver is not Sync; the lock only lets the wait run without the GIL.
+    let receiver = Mutex::new(receiver);
+    let mut interrupted: Option<PyErr> = None;
+    let result = std::thread::scope(|scope| {
+        let (jobs, options, stop) = (&jobs, &options, &stop);
+        let worker = scope.spawn(move || {
+            no_panic(|| {
+                let on_record = |record: &Record| {
+                    let _ = sender.send(record.clone());
+                };
+                run_batch(jobs, options, &on_record, stop).map_err(refused)
+            })
+        });
+        loop {
+            let next = py.detach(|| {
+                let receiver = receiver.lock().unwrap_or_else(|e| e.into_inner());
+                receiver.recv_timeout(Duration::from_millis(100))
+            });
+            let step = match next {
+                Ok(record) => py.check_signals().and_then(|()| match &progress {
+                    Some(callback) => serde_json::to_value(&record)
+                        .map_err(|e| PyValueError::new_err(e.to_string()))
+                        .and_then(|value| json_object(py, &value))
+                        .and_then(|record| callback.call1((record,)).map(drop)),
+                    None => Ok(()),
+                }),
+                Err(RecvTimeoutError::Timeout) => py.check_signals(),
+                Err(RecvTimeoutError::Disconnected) => break,
+            };
+            if let Err(error) = step {
+                stop.store(true, Ordering::Relaxed);
+                interrupted.get_or_insert(error);
+            }
+        }
+        py.detach(|| worker.join())
+    });
+    if let Some(error) = interrupted {
+        return Err(error);
+    }
+    let (records, summary) = result.unwrap_or_else(|_| {
+        Err(pyo3::exceptions::PyRuntimeError::new_err(
+            "atlas-skin internal error: the batch thread ended abnormally",
+        ))
+    })?;
+    json_object(
+        py,
+        &serde_json::json!({"records": records, "summary": summary}),
+    )
 }
 
 #[pymodule]

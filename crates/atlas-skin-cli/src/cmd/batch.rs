@@ -4,10 +4,11 @@
 
 use crate::cmd::skin::MethodArgs;
 use anyhow::{bail, Result};
-use atlas_skin_job::batch::{collect_inputs, plan_jobs, run_batch, BatchOptions, Status};
+use atlas_skin_job::batch::{collect_inputs, plan_jobs, run_batch, BatchOptions, Record, Status};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
 
 /// Arguments.
 #[derive(clap::Args)]
@@ -54,13 +55,14 @@ pub fn run(args: Args) -> Result<()> {
     let inputs = collect_inputs(&args.inputs)?;
     let jobs = plan_jobs(&inputs, &options)?;
     let bar = progress_bar(jobs.len() as u64);
-    let (_, summary) = run_batch(&jobs, &options, &|record| {
+    let on_record = |record: &Record| {
         if record.status == Status::Failed {
             let message = record.error.as_deref().unwrap_or_default();
             bar.suspend(|| eprintln!("error: {message}"));
         }
         bar.inc(1);
-    })?;
+    };
+    let (_, summary) = run_batch(&jobs, &options, &on_record, &AtomicBool::new(false))?;
     bar.finish_and_clear();
     println!("{summary}");
     if summary.failed > 0 {

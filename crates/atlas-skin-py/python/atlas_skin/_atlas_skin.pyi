@@ -1,7 +1,7 @@
 """Type stubs of atlas_skin's native module (crates/atlas-skin-py/src/lib.rs)."""
 
 from os import PathLike
-from typing import Any, Dict, Mapping, Optional, Sequence, Tuple, TypedDict, Union
+from typing import Any, Callable, Dict, Mapping, Optional, Sequence, Tuple, TypedDict, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -170,6 +170,7 @@ def batch(
     report: bool = False,
     html: bool = False,
     log: Optional[StrPath] = None,
+    progress: Optional[Callable[[Dict[str, Any]], object]] = None,
     **options: Unpack[MethodOptions],
 ) -> Dict[str, Any]:
     """The job of ``atlas-skin batch INPUT... -o OUT_DIR``: every character of ``inputs``
@@ -181,11 +182,16 @@ def batch(
     others. Each finished file appends a record to the JSON-lines ``log`` (default
     ``OUT_DIR/atlas-skin-batch.jsonl``). The method's options as ``compute_weights``.
 
+    ``progress`` is called on the calling thread with each record as its file finishes
+    (for a progress bar). An exception from it, or Ctrl-C (``KeyboardInterrupt``), stops
+    the batch: the files running finish (their outputs complete), the others are not
+    started and are logged as ``"cancelled"``, then the exception is raised.
+
     Returns ``{"records": [...], "summary": {...}}``: one record per file, in the order
     of the inputs (``input``, ``output``, ``status``: ``"ok"``, ``"failed"`` or
-    ``"skipped"``, ``error``: the message ``skin`` would print or None, ``seconds``,
+    ``"skipped"``, ``"cancelled"``, ``error``: the message ``skin`` would print or None, ``seconds``,
     ``timings_ms``, ``counts``, ``warnings``), and the totals (``files``, ``ok``,
-    ``failed``, ``skipped``, ``seconds``, ``characters_per_second``, ``log``). A failed
+    ``failed``, ``skipped``, ``cancelled``, ``seconds``, ``characters_per_second``, ``log``). A failed
     file is in the records, not raised. Raises ``ValueError`` when the batch cannot start
     (a pattern matching nothing, a folder without character files, two inputs with one
     name, an output over an input).
