@@ -1,0 +1,101 @@
+"""skin_file and batch: the CLI's jobs from Python, with the same outputs."""
+
+import json
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+import atlas_skin
+from conftest import data
+
+
+def test_skin_file_writes_what_the_cli_writes(cli, tmp_path):
+    source = data("bench/kaykit/Knight.glb")
+    report = atlas_skin.skin_file(source, tmp_path / "py.glb", report=tmp_path / "py.json", max_influences=3)
+    cli("skin", source, "-o", tmp_path / "cli.glb", "--max-influences", "3")
+    assert (tmp_path / "py.glb").read_bytes() == (tmp_path / "cli.glb").read_bytes()
+    assert report == json.loads((tmp_path / "py.json").read_text())
+    assert report["counts"]["max_influences"] <= 3
+    assert report["input"] == str(source)
+
+
+def test_batch_skins_every_file_and_records_the_failures(tmp_path):
+    inputs = tmp_path / "in"
+    inputs.mkdir()
+    for relative in ["bench/kaykit/Knight.glb", "bench/kaykit/Mage.glb"]:
+        (inputs / relative.split("/")[-1]).write_bytes(data(relative).read_bytes())
+    (inputs / "broken.glb").write_bytes(b"not a glb at all")
+    result = atlas_skin.batch([inputs], tmp_path / "out", jobs=2, report=True)
+    summary = result["summary"]
+    assert (summary["files"], summary["ok"], summary["failed"], summary["skipped"]) == (3, 2, 1, 0)
+    by_name = {r["input"].split("/")[-1]: r for r in result["records"]}
+    assert by_name["broken.glb"]["status"] == "failed"
+    assert "broken.glb" in by_name["broken.glb"]["error"]
+    for name in ["Knight", "Mage"]:
+        assert by_name[f"{name}.glb"]["status"] == "ok"
+        assert (tmp_path / "out" / f"{name}.glb").is_file()
+        assert (tmp_path / "out" / f"{name}.json").is_file()
+    log = (tmp_path / "out" / "atlas-skin-batch.jsonl").read_text().splitlines()
+    assert len(log) == 3
+
+    again = atlas_skin.batch(str(inputs / "*.glb"), tmp_path / "out", resume=True, report=True)
+    statuses = sorted(r["status"] for r in again["records"])
+    assert statuses == ["failed", "skipped", "skipped"]
+
+
+def test_batch_that_cannot_start(tmp_path):
+    with pytest.raises(ValueError, match="matches no file"):
+        atlas_skin.batch([str(tmp_path / "*.glb")], tmp_path / "out")
+    with pytest.raises(ValueError, match=r"jobs 0 is outside 1..=256"):
+        atlas_skin.batch([data("bench/kaykit/Knight.glb")], tmp_path / "out", jobs=0)
+
+
+def test_progress_sees_every_record_and_an_exception_stops_the_batch(tmp_path):
+    inputs = tmp_path / "in"
+    inputs.mkdir()
+    knight = data("bench/kaykit/Knight.glb").read_bytes()
+    for i in range(8):
+        (inputs / f"knight{i}.glb").write_bytes(knight)
+    seen = []
+    result = atlas_skin.batch(inputs, tmp_path / "all", jobs=2, progress=seen.append)
+    assert sorted(r["input"] for r in seen) == sorted(r["input"] for r in result["records"])
+    assert len(seen) == 8
+
+    class Stop(Exception):
+        pass
+
+    def stop_at_once(record):
+        raise Stop(record["input"])
+
+    with pytest.raises(Stop):
+        atlas_skin.batch(inputs, tmp_path / "stopped", jobs=1, progress=stop_at_once)
+    log = [json.loads(line) for line in (tmp_path / "stopped" / "atlas-skin-batch.jsonl").read_text().splitlines()]
+    assert len(log) == 8
+    statuses = [r["status"] for r in log]
+    assert statuses.count("cancelled") >= 1, statuses
+    assert set(statuses) <= {"ok", "cancelled"}
+    written = sorted(p.name for p in (tmp_path / "stopped").glob("*.glb"))
+    assert written == sorted(r["output"].rsplit("/", 1)[-1] for r in log if r["status"] == "ok")
+
+
+def test_ctrl_c_stops_a_batch(tmp_path):
+    """SIGINT while the batch runs: KeyboardInterrupt, every file logged, the rest cancelled."""
+    out = tmp_path / "out"
+    log = out / "atlas-skin-batch.jsonl"
+    script = f"import atlas_skin; atlas_skin.batch({str(data('bench'))!r}, {str(out)!r}, jobs=1)"
+    child = subprocess.Popen([sys.executable, "-c", script], stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while not (log.exists() and log.read_text().count("\n") >= 2):
+        assert child.poll() is None and time.monotonic() < deadline, "the batch ended or did not start"
+        time.sleep(0.005)
+    child.send_signal(signal.SIGINT)
+    _, stderr = child.communicate(timeout=60)
+    assert child.returncode != 0
+    assert "KeyboardInterrupt" in stderr
+    records = [json.loads(line) for line in log.read_text().splitlines()]
+    assert len(records) == 65
+    statuses = [r["status"] for r in records]
+    assert statuses.count("cancelled") > 0 and statuses.count("ok") >= 2, statuses
