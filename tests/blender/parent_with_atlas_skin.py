@@ -1,0 +1,292 @@
+"""Tests the Blender add-on "Parent with Atlas-Skin weights" (blender/atlas_skin_blender)
+in Blender as a Python module (the `bpy` package of PyPI).
+
+The extension zip is installed the way Preferences > Get Extensions > Install from Disk
+does (Blender installs its bundled `atlas_skin` wheel), into a fresh user folder. Then, for
+the demo character, two corpus characters and a KayKit character of nine meshes on one
+skeleton, all imported with Blender's glTF importer and their weights removed:
+- the operator runs on the armature and all the meshes at once;
+- every vertex is in at least one bone group, the weights of each vertex sum to 1, at most
+  4 per vertex; a group that names no bone is kept; every mesh has the armature as parent
+  and one Armature modifier;
+- the weights equal those `atlas-skin skin` writes for the same file, within 1e-5 (the glb
+  it writes is the input document with new weights, so Blender imports the same vertices
+  in the same order);
+- turning each deforming bone in pose mode moves its part and nothing else;
+- running again gives the same groups, bit for bit; undo takes everything back.
+Then: the redo options against the command line's, the error paths, modifiers, and a
+Workbench render of the posed KayKit character coloured by its weights (the README's).
+
+Usage: python parent_with_atlas_skin.py EXTENSION.zip ATLAS_SKIN DATA_DIR OUT_DIR
+(scripts/test-blender-addon passes them).
+"""
+import os
+import subprocess
+import sys
+import tempfile
+
+EXTENSION_ZIP, ATLAS_SKIN, DATA, OUT = sys.argv[1:5]
+# Blender reads its user folder when bpy is imported: a fresh one, so the extension is
+# installed there and nowhere else.
+USER = tempfile.mkdtemp(prefix="atlas-skin-blender-")
+os.environ["BLENDER_USER_RESOURCES"] = USER
+
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+from mathutils import Euler  # noqa: E402
+from skinned import (  # noqa: E402
+    bone_weights,
+    check_groups,
+    check_matches_cli,
+    check_pose,
+    cli_weights,
+    deforming_names,
+    groups_snapshot,
+    import_character,
+    run_operator,
+    strip_weights,
+)
+
+ADDON = "bl_ext.user_default.atlas_skin_blender"
+
+
+def install_extension():
+    result = bpy.ops.extensions.package_install_files(
+        filepath=EXTENSION_ZIP, repo="user_default", enable_on_install=True
+    )
+    assert result == {"FINISHED"}, result
+    assert ADDON in bpy.context.preferences.addons, list(bpy.context.preferences.addons.keys())
+    import atlas_skin
+
+    where = os.path.realpath(atlas_skin.__file__)
+    assert where.startswith(os.path.realpath(USER)), (
+        f"atlas_skin imported from {where}, not from the wheel the extension installed"
+    )
+
+
+def check_character(name, path, unparent):
+    cli_names, cli = cli_weights(ATLAS_SKIN, path, os.path.join(OUT, f"{name}-cli.glb"))
+    armature, meshes = import_character(path)
+    strip_weights(meshes, unparent)
+    keep = meshes[0].vertex_groups.new(name="not_a_bone")
+    keep.add([0, 1, 2], 0.25, "REPLACE")
+    before = groups_snapshot(meshes)
+    bpy.ops.ed.undo_push(message="before")
+    assert run_operator(armature, meshes, undo=True, use_tails=False) == {"FINISHED"}
+    names = deforming_names(armature)
+    check_groups(name, meshes, names)
+    worst = check_matches_cli(name, meshes, names, cli_names, cli)
+    kept = [
+        (v.index, g.weight) for v in meshes[0].data.vertices for g in v.groups if g.group == keep.index
+    ]
+    assert kept == [(0, 0.25), (1, 0.25), (2, 0.25)], f"{name}: the non-bone group changed: {kept[:5]}"
+    for obj in meshes:
+        assert obj.parent == armature and obj.parent_type == "OBJECT", f"{name}/{obj.name}: parent"
+        assert [(m.type, m.object) for m in obj.modifiers] == [("ARMATURE", armature)]
+    check_pose(name, armature, meshes, names)
+    first = groups_snapshot(meshes)
+    assert run_operator(armature, meshes, use_tails=False) == {"FINISHED"}
+    assert groups_snapshot(meshes) == first, f"{name}: a second run changed the groups"
+    bpy.ops.ed.undo()
+    meshes = [bpy.data.objects[o] for o in before]
+    assert groups_snapshot(meshes) == before, f"{name}: undo did not restore the meshes"
+    vertices = sum(len(o.data.vertices) for o in meshes)
+    print(
+        f"{name}: {vertices} vertices in {len(meshes)} mesh(es), {len(names)} bones: groups, "
+        f"same as atlas-skin skin (largest difference {worst:.1e}), pose, second run, undo: ok"
+    )
+
+
+def weights_with(path, **options):
+    """The operator's weights for the character in `path`, all meshes, with options."""
+    armature, meshes = import_character(path)
+    strip_weights(meshes)
+    assert run_operator(armature, meshes, **options) == {"FINISHED"}
+    names = deforming_names(armature)
+    return np.concatenate([bone_weights(o, names) for o in meshes])
+
+
+def check_options(path):
+    """Every redo option gives what the command line's same option gives, and changes the
+    weights."""
+    cases = [
+        ({"max_influences": 2}, ["--max-influences", "2"]),
+        ({"blend": "PAPER"}, ["--blend", "paper"]),
+        ({"overlap": 0.25, "bone_overlap": "lowerarm_l=1.5, upleg_r = 0.1"},
+         ["--overlap", "0.25", "--overlap-joint", "lowerarm_l=1.5", "--overlap-joint", "upleg_r=0.1"]),
+        ({"force": "head", "forbid": "lowerleg_l, hand_r"},
+         ["--force", "head", "--forbid", "lowerleg_l", "--forbid", "hand_r"]),
+    ]
+    default = weights_with(path, use_tails=False)
+    for options, flags in cases:
+        cli_names, cli = cli_weights(ATLAS_SKIN, path, os.path.join(OUT, "options-cli.glb"), *flags)
+        armature, meshes = import_character(path)
+        strip_weights(meshes)
+        assert run_operator(armature, meshes, use_tails=False, **options) == {"FINISHED"}
+        names = deforming_names(armature)
+        check_groups(f"demo {options}", meshes, names, options.get("max_influences", 4))
+        check_matches_cli(f"demo {options}", meshes, names, cli_names, cli)
+        differs = np.abs(np.concatenate([bone_weights(o, names) for o in meshes]) - default).max()
+        assert differs > 0.01, f"{options} change nothing"
+        print(f"options {options}: same as `atlas-skin skin {' '.join(flags)}`; "
+              f"differ from the defaults by up to {differs:.2f}")
+
+
+def check_tails(path):
+    """Bone tails (on by default) make leaf bones segments, which a glTF file has not."""
+    armature, meshes = import_character(path)
+    strip_weights(meshes)
+    assert run_operator(armature, meshes) == {"FINISHED"}
+    check_groups("with bone tails", meshes, deforming_names(armature))
+    differs = np.abs(weights_with(path) - weights_with(path, use_tails=False)).max()
+    assert differs > 0.01, "the bone tails change nothing"
+    print(f"bone tails: valid weights, differ from the heads alone by up to {differs:.2f}")
+
+
+def expect_error(armature, meshes, fragment, **options):
+    before = groups_snapshot(meshes)
+    try:
+        run_operator(armature, meshes, **options)
+    except RuntimeError as error:
+        assert fragment in str(error), f"expected '{fragment}' in: {error}"
+    else:
+        raise AssertionError(f"no error for {options}; expected '{fragment}'")
+    assert groups_snapshot(meshes) == before, f"{options}: the scene changed on an error"
+
+
+def check_errors(path):
+    armature, meshes = import_character(path)
+    strip_weights(meshes)
+    bpy.ops.object.select_all(action="DESELECT")
+    meshes[0].select_set(True)
+    assert not bpy.ops.object.parent_atlas_skin.poll(), "runs without an armature"
+    expect_error(armature, meshes, "'nope' is not a deforming bone", force="head, nope")
+    expect_error(armature, meshes, "is not BONE=NUMBER", bone_overlap="head")
+    expect_error(armature, meshes, "must be a positive number", bone_overlap="head=-1")
+    twin = meshes[0].copy()
+    bpy.context.collection.objects.link(twin)
+    expect_error(armature, [meshes[0], twin], "share the mesh")
+    bpy.data.objects.remove(twin)
+    for bone in armature.data.bones:
+        bone.use_deform = False
+    expect_error(armature, meshes, "has no deforming bone")
+    print("errors: no armature, unknown bone, bad per-bone overlap, linked duplicates, "
+          "no deforming bone: refused, scene unchanged")
+
+
+def check_modifiers(path):
+    """A mesh is read with its modifiers, as Blender's binding reads it; modifiers that
+    change the vertex count are left out, with a warning."""
+    from bl_ext.user_default.atlas_skin_blender.body import read_body, rest_state
+
+    armature, meshes = import_character(path)
+    strip_weights(meshes)
+    body = meshes[0]
+    body.shape_key_add(name="Basis")
+    fat = body.shape_key_add(name="fat")
+    fat.value = 1.0
+    for point, vertex in zip(fat.data, body.data.vertices):
+        point.co = vertex.co + 0.01 * vertex.normal
+    with rest_state(armature, meshes):
+        evaluated = read_body(bpy.context.evaluated_depsgraph_get(), armature, meshes)
+    assert not evaluated.warnings, evaluated.warnings
+    moved = np.abs(evaluated.positions - positions_of_data(armature, body)).max()
+    assert abs(moved - 0.01) < 1e-3, f"shape key not read: moved by {moved}"
+    body.modifiers.new(name="Subdivision", type="SUBSURF")
+    with rest_state(armature, meshes):
+        base = read_body(bpy.context.evaluated_depsgraph_get(), armature, meshes)
+    assert "change the vertex count" in base.warnings[0], base.warnings
+    assert len(base.positions) == len(body.data.vertices)
+    assert run_operator(armature, meshes) == {"FINISHED"}
+    assert [m.type for m in body.modifiers] == ["ARMATURE", "SUBSURF"], "Armature not first"
+    check_groups("demo with a shape key and a Subdivision", meshes, deforming_names(armature))
+    print("modifiers: shape key read evaluated, Subdivision left out with a warning, "
+          "Armature modifier first")
+
+
+def positions_of_data(armature, obj):
+    """obj's own vertices (no shape key, no modifier) as the add-on reads them."""
+    from bl_ext.user_default.atlas_skin_blender.axes import to_gltf_axes
+
+    local = np.array([v.co for v in obj.data.vertices])
+    return to_gltf_axes(local, armature.matrix_world.inverted() @ obj.matrix_world)
+
+
+def render_screenshot(path, png):
+    """The KayKit knight weighted by the add-on, posed, each bone's colour blended by the
+    weights, rendered with Workbench."""
+    armature, meshes = import_character(path)
+    strip_weights(meshes)
+    assert run_operator(armature, meshes) == {"FINISHED"}
+    names = deforming_names(armature)
+    hues = np.linspace(0.0, 1.0, len(names), endpoint=False)
+    rng = np.random.default_rng(3)
+    palette = np.array([hsv(h, 0.65, 0.95) for h in rng.permutation(hues)])
+    for obj in meshes:
+        colours = bone_weights(obj, names) @ palette
+        attribute = obj.data.color_attributes.new("weights", "FLOAT_COLOR", "POINT")
+        rgba = np.concatenate([colours, np.ones((len(colours), 1))], axis=1)
+        attribute.data.foreach_set("color", rgba.ravel())
+        obj.data.color_attributes.active_color = attribute
+    pose = {
+        "upperarm.l": (0, 0, -70), "lowerarm.l": (0, 0, -50), "upperarm.r": (-40, 0, 30),
+        "lowerarm.r": (-60, 0, 0), "upperleg.l": (35, 0, 0), "lowerleg.l": (-60, 0, 0),
+        "upperleg.r": (-25, 0, 0), "head": (10, 25, 0), "spine": (0, 15, 0),
+    }
+    for bone, degrees in pose.items():
+        pose_bone = armature.pose.bones.get(bone)
+        assert pose_bone is not None, f"no bone {bone} in {path}: {names}"
+        pose_bone.rotation_mode = "XYZ"
+        pose_bone.rotation_euler = Euler(np.radians(degrees))
+    scene = bpy.context.scene
+    camera = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
+    scene.collection.objects.link(camera)
+    camera.location = (2.4, -5.2, 2.2)
+    camera.rotation_euler = Euler(np.radians((78, 0, 25)))
+    camera.data.lens = 55
+    scene.camera = camera
+    scene.render.engine = "BLENDER_WORKBENCH"
+    scene.display.shading.light = "STUDIO"
+    scene.display.shading.color_type = "VERTEX"
+    scene.display.shading.show_cavity = True
+    scene.render.resolution_x, scene.render.resolution_y = 900, 900
+    scene.render.film_transparent = False
+    scene.render.filepath = png
+    bpy.ops.render.render(write_still=True)
+    print(f"render: {png}")
+
+
+def hsv(h, s, v):
+    import colorsys
+
+    return colorsys.hsv_to_rgb(h, s, v)
+
+
+def main():
+    os.makedirs(OUT, exist_ok=True)
+    install_extension()
+    subprocess.run([ATLAS_SKIN, "demo", "-o", OUT], check=True, capture_output=True)
+    demo = os.path.join(OUT, "demo.glb")
+    knight = os.path.join(DATA, "bench/kaykit/Knight.glb")
+    # (file, whether the meshes lose their parent too): the corpus characters stay children
+    # of their armature, which Blender's importer places under a turned node (a mesh
+    # carried into the armature's space through that turn would move by 1e-7, enough to
+    # move a vertex lying on a cut plane to the plane's other side).
+    characters = {
+        "demo": (demo, True),
+        "cesiumman": (os.path.join(DATA, "models/cesiumman/CesiumMan.glb"), False),
+        "riggedfigure": (os.path.join(DATA, "models/riggedfigure/RiggedFigure.glb"), False),
+        "kaykit-knight": (knight, True),
+    }
+    for name, (path, unparent) in characters.items():
+        assert os.path.isfile(path), f"{path} is missing (tests never skip)"
+        check_character(name, path, unparent)
+    check_options(demo)
+    check_tails(knight)
+    check_errors(demo)
+    check_modifiers(demo)
+    render_screenshot(knight, os.path.join(OUT, "blender-addon.png"))
+    print("all checks of the Blender add-on passed")
+
+
+main()
