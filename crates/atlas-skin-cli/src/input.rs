@@ -3,7 +3,7 @@
 use anyhow::{Context, Result};
 use atlas_skin::pipeline::{skin, SkinInput, SkinParams, WeldedSurface};
 use atlas_skin::{MeshStats, Topology, Welded};
-use atlas_skin_io::{Character, LoadOptions, TriangleMesh};
+use atlas_skin_io::{Character, LoadOptions};
 use std::path::{Path, PathBuf};
 
 /// How to read a character's files, besides its main file.
@@ -56,13 +56,15 @@ impl InputArgs {
 
     /// Reads the character, or builds the demo character when no input is given.
     pub fn load(&self) -> Result<Character> {
-        match &self.input {
-            // The reader's errors name the file already.
-            Some(path) => Ok(atlas_skin_io::load_character(
-                path,
-                &self.read.load_options(),
-            )?),
-            None => Ok(demo_character()),
+        // The reader's errors name the file already.
+        Ok(self.job_input().load()?)
+    }
+
+    /// The input as the skinning job takes it.
+    pub fn job_input(&self) -> atlas_skin_job::Input {
+        atlas_skin_job::Input {
+            path: self.input.clone(),
+            load: self.read.load_options(),
         }
     }
 
@@ -98,21 +100,6 @@ pub fn skin_character(character: &mut Character) -> Result<()> {
     .with_context(|| format!("cannot skin {}", character.path.display()))?;
     character.reference_weights = Some(skinned.weights);
     Ok(())
-}
-
-/// The built-in demo character ([`atlas_skin::fixtures::demo`]) as if read from a file named
-/// `demo`: mesh and skeleton, no weights.
-pub fn demo_character() -> Character {
-    let demo = atlas_skin::fixtures::demo::demo_character(atlas_skin::fixtures::demo::DEFAULT_STEP);
-    let mut character = Character::new(
-        "demo",
-        TriangleMesh {
-            positions: demo.positions,
-            triangles: demo.triangles,
-        },
-    );
-    character.skeleton = Some(demo.skeleton);
-    character
 }
 
 /// A character with its welded surface and topology, ready for the method.

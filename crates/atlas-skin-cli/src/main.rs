@@ -2,7 +2,6 @@
 
 mod cmd;
 mod counts;
-mod html;
 mod input;
 mod skinning_data;
 

@@ -1,10 +1,10 @@
 //! `atlas-skin demo`: write the project's own demo character.
 
-use crate::input::demo_character;
 use anyhow::{Context, Result};
 use atlas_skin::skeleton::bones::nearest_bone_weights;
 use atlas_skin_io::gltf::{skinned_glb, WriteOptions};
 use atlas_skin_io::OutputPlan;
+use atlas_skin_job::demo_character;
 use std::path::PathBuf;
 
 /// Writes DIR/demo.glb: the built-in demo character (a closed, genus-0 humanoid with hands,

@@ -1,11 +1,11 @@
 //! `atlas-skin report`: the self-contained HTML report of a skinned glTF binary (see
-//! [`crate::html`]).
+//! [`atlas_skin_job::html`]).
 
 use anyhow::Context;
 use atlas_skin_io::OutputPlan;
 use std::path::{Path, PathBuf};
 
-pub use crate::html::write_html;
+use atlas_skin_job::html::write_html;
 
 /// Arguments.
 #[derive(clap::Args)]

@@ -10,10 +10,25 @@
 //! skinned mesh, glb order; overrides the dominant joint), `timings_ms` (stage → ms),
 //! `warnings` (strings), `counts` and any other top-level scalar.
 
-use anyhow::{bail, Context};
-use atlas_skin_io::OutputPlan;
+use atlas_skin_io::{IoError, OutputPlan};
 use base64::Engine;
 use std::path::Path;
+use thiserror::Error;
+
+/// Why the page could not be made or written.
+#[derive(Debug, Error)]
+pub enum HtmlError {
+    /// The model is not a glTF 2.0 binary.
+    #[error("{0}")]
+    Glb(String),
+    /// The viewer template is broken (a marker unclosed or unknown).
+    #[error("{0}")]
+    Template(String),
+    #[error("serialising the report JSON")]
+    Report(#[source] serde_json::Error),
+    #[error(transparent)]
+    Write(#[from] IoError),
+}
 
 /// The page around the model; `@@NAME@@` markers are filled by [`fill_template`].
 const TEMPLATE: &str = include_str!("../viewer/viewer.html");
@@ -48,7 +63,7 @@ pub fn write_html(
     report_json: Option<&serde_json::Value>,
     out: &Path,
     plan: &OutputPlan,
-) -> anyhow::Result<()> {
+) -> Result<(), HtmlError> {
     check_glb_header(glb_bytes)?;
     let title = out
         .file_stem()
@@ -95,7 +110,7 @@ fn is_comment_line(line: &str) -> bool {
 }
 
 /// Checks the 12-byte GLB header: magic, version 2 and a declared length equal to the data's.
-fn check_glb_header(bytes: &[u8]) -> anyhow::Result<()> {
+fn check_glb_header(bytes: &[u8]) -> Result<(), HtmlError> {
     let word = |at: usize| {
         bytes
             .get(at..at + 4)
@@ -103,38 +118,41 @@ fn check_glb_header(bytes: &[u8]) -> anyhow::Result<()> {
     };
     match (word(0), word(4), word(8)) {
         (Some(GLB_MAGIC), Some(2), Some(length)) if length as usize == bytes.len() => Ok(()),
-        (Some(GLB_MAGIC), Some(2), Some(length)) => bail!(
+        (Some(GLB_MAGIC), Some(2), Some(length)) => Err(HtmlError::Glb(format!(
             "the glTF binary declares {length} bytes but has {}",
             bytes.len()
-        ),
-        (Some(GLB_MAGIC), Some(version), _) => {
-            bail!("glTF binary version {version} is not supported (only 2)")
-        }
-        _ => bail!("not a glTF binary (.glb): the file does not start with \"glTF\""),
+        ))),
+        (Some(GLB_MAGIC), Some(version), _) => Err(HtmlError::Glb(format!(
+            "glTF binary version {version} is not supported (only 2)"
+        ))),
+        _ => Err(HtmlError::Glb(
+            "not a glTF binary (.glb): the file does not start with \"glTF\"".into(),
+        )),
     }
 }
 
 /// Replaces every `@@NAME@@` marker of `template` by its value in one pass, so text inside
 /// the values (model data, report strings) is never taken for a marker. An unknown or
 /// unclosed marker is an error.
-fn fill_template(template: &str, values: &[(&str, &str)]) -> anyhow::Result<String> {
+fn fill_template(template: &str, values: &[(&str, &str)]) -> Result<String, HtmlError> {
     let mut page =
         String::with_capacity(template.len() + values.iter().map(|(_, v)| v.len()).sum::<usize>());
     let mut rest = template;
     while let Some(start) = rest.find("@@") {
         page.push_str(&rest[..start]);
         let after = &rest[start + 2..];
-        let end = after.find("@@").with_context(|| {
-            format!(
+        let end = after.find("@@").ok_or_else(|| {
+            HtmlError::Template(format!(
                 "unclosed marker in the viewer template near {:?}",
                 &after[..after.len().min(20)]
-            )
+            ))
         })?;
         let name = &after[..end];
-        let (_, value) = values
-            .iter()
-            .find(|(key, _)| *key == name)
-            .with_context(|| format!("the viewer template has an unknown marker @@{name}@@"))?;
+        let (_, value) = values.iter().find(|(key, _)| *key == name).ok_or_else(|| {
+            HtmlError::Template(format!(
+                "the viewer template has an unknown marker @@{name}@@"
+            ))
+        })?;
         page.push_str(value);
         rest = &after[end + 2..];
     }
@@ -165,8 +183,8 @@ fn with_viewer_precision(value: &serde_json::Value) -> serde_json::Value {
 
 /// JSON that can sit inside a `<script>` element: `<` (which only occurs inside JSON
 /// strings) becomes the escape `\u003c`, so no `</script>` or `<!--` can end the element.
-fn script_safe_json(value: &serde_json::Value) -> anyhow::Result<String> {
-    let text = serde_json::to_string(value).context("serialising the report JSON")?;
+fn script_safe_json(value: &serde_json::Value) -> Result<String, HtmlError> {
+    let text = serde_json::to_string(value).map_err(HtmlError::Report)?;
     Ok(text.replace('<', "\\u003c"))
 }
 

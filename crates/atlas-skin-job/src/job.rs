@@ -1,0 +1,268 @@
+//! One file-skinning job (`atlas-skin skin`): read a character, compute its weights
+//! ([`atlas_skin::pipeline::skin`]: cuts at the joints, regions, overlaps along the surface,
+//! blended weights), write the skinned glTF binary and, when asked, the JSON report, the
+//! HTML report, a debug view and RigNet's rig_info text. Every output goes through one
+//! [`OutputPlan`], checked before any work: complete or untouched, never over an input.
+
+use crate::html::{write_html, HtmlError};
+use crate::report::{skin_report, stage_timings};
+use crate::settings::{Settings, SettingsError};
+use atlas_skin::pipeline::{skin, SkinError, SkinInput, Skinned};
+use atlas_skin::report::{debug_colors, debug_lines};
+use atlas_skin_io::gltf::{debug_glb, skinned_glb, WriteOptions};
+use atlas_skin_io::{Character, IoError, LoadOptions, OutputPlan, TriangleMesh};
+use glam::Vec3;
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+use thiserror::Error;
+
+/// Why a job failed. Each message names the file and the problem; causes are error sources
+/// (a chain printer such as anyhow's `{:#}` joins them with `: `, see [`error_chain`]).
+#[derive(Debug, Error)]
+pub enum JobError {
+    /// Reading the character, planning or writing an output.
+    #[error(transparent)]
+    Io(#[from] IoError),
+    #[error(transparent)]
+    Settings(#[from] SettingsError),
+    #[error("{} has no skeleton: give one with --skeleton", path.display())]
+    NoSkeleton { path: PathBuf },
+    #[error("cannot skin {}", path.display())]
+    Skin {
+        path: PathBuf,
+        #[source]
+        source: SkinError,
+    },
+    #[error("cannot write {}", path.display())]
+    DebugView {
+        path: PathBuf,
+        #[source]
+        source: IoError,
+    },
+    #[error("cannot serialise the report")]
+    Report(#[source] serde_json::Error),
+    #[error(transparent)]
+    Html(#[from] HtmlError),
+}
+
+/// `error` and its sources joined by `: `, as the command line prints them.
+pub fn error_chain(error: &dyn std::error::Error) -> String {
+    let mut text = error.to_string();
+    let mut source = error.source();
+    while let Some(cause) = source {
+        text.push_str(": ");
+        text.push_str(&cause.to_string());
+        source = cause.source();
+    }
+    text
+}
+
+/// Where the character comes from.
+#[derive(Debug, Clone, Default)]
+pub struct Input {
+    /// The character's file; `None`: the built-in demo character ([`demo_character`]).
+    pub path: Option<PathBuf>,
+    /// Companion files (skeleton, reference weights) and the OBJ group.
+    pub load: LoadOptions,
+}
+
+impl Input {
+    /// A character file with no companion file.
+    pub fn file(path: impl Into<PathBuf>) -> Self {
+        Self {
+            path: Some(path.into()),
+            load: LoadOptions::default(),
+        }
+    }
+
+    /// Every file read: the character's and its companions.
+    pub fn paths(&self) -> impl Iterator<Item = &Path> {
+        self.path
+            .as_deref()
+            .into_iter()
+            .chain(self.load.skeleton.as_deref())
+            .chain(self.load.weights.as_deref())
+    }
+
+    /// Reads the character, or builds the demo character.
+    pub fn load(&self) -> Result<Character, IoError> {
+        match &self.path {
+            Some(path) => atlas_skin_io::load_character(path, &self.load),
+            None => Ok(demo_character()),
+        }
+    }
+}
+
+/// The built-in demo character ([`atlas_skin::fixtures::demo`]) as if read from a file named
+/// `demo`: mesh and skeleton, no weights.
+pub fn demo_character() -> Character {
+    let demo = atlas_skin::fixtures::demo::demo_character(atlas_skin::fixtures::demo::DEFAULT_STEP);
+    let mut character = Character::new(
+        "demo",
+        TriangleMesh {
+            positions: demo.positions,
+            triangles: demo.triangles,
+        },
+    );
+    character.skeleton = Some(demo.skeleton);
+    character
+}
+
+/// The files a job writes: the skinned glb always, the others when given.
+#[derive(Debug, Clone, Default)]
+pub struct Outputs {
+    /// The skinned glTF binary.
+    pub glb: PathBuf,
+    /// The JSON report ([`skin_report`]).
+    pub report: Option<PathBuf>,
+    /// The self-contained HTML report ([`crate::html`]).
+    pub html: Option<PathBuf>,
+    /// An unskinned glb with the regions as vertex colours and the cut curves as lines.
+    pub debug_glb: Option<PathBuf>,
+    /// The weights (pruned as in the glb) and the skeleton in RigNet's rig_info text.
+    pub rig_info: Option<PathBuf>,
+}
+
+impl Outputs {
+    /// Only the skinned glb.
+    pub fn glb(path: impl Into<PathBuf>) -> Self {
+        Self {
+            glb: path.into(),
+            ..Self::default()
+        }
+    }
+
+    fn paths(&self) -> impl Iterator<Item = &Path> {
+        [
+            Some(&self.glb),
+            self.report.as_ref(),
+            self.debug_glb.as_ref(),
+            self.html.as_ref(),
+            self.rig_info.as_ref(),
+        ]
+        .into_iter()
+        .flatten()
+        .map(PathBuf::as_path)
+    }
+}
+
+/// One character to skin: what to read, with which settings, and what to write.
+#[derive(Debug, Clone, Default)]
+pub struct SkinJob {
+    pub input: Input,
+    pub settings: Settings,
+    pub outputs: Outputs,
+}
+
+/// What a finished job tells its caller.
+#[derive(Debug, Clone)]
+pub struct JobOutcome {
+    /// The JSON report (also written when [`Outputs::report`] is given).
+    pub report: Value,
+    /// What the method noticed and handled (the report's warnings also hold the reader's).
+    pub method_warnings: Vec<String>,
+    /// One line: input, vertices, joints (cut, soft, skipped), regions, output.
+    pub summary: String,
+}
+
+impl SkinJob {
+    /// Runs the job (see the module documentation). `progress` is told each step as it
+    /// starts: the method's stages by name, then `writing`.
+    pub fn run(&self, progress: &mut dyn FnMut(&'static str)) -> Result<JobOutcome, JobError> {
+        let outputs = &self.outputs;
+        let plan = OutputPlan::new(
+            self.input.paths().chain(self.settings.paths()),
+            outputs.paths(),
+        )?;
+        let params = self.settings.params()?;
+        let character = self.input.load()?;
+        let Some(skeleton) = character.skeleton.clone() else {
+            return Err(JobError::NoSkeleton {
+                path: character.path.clone(),
+            });
+        };
+        let skinned = skin(
+            SkinInput {
+                positions: &character.mesh.positions,
+                triangles: &character.mesh.triangles,
+                skeleton: &skeleton,
+                end_joints: &character.end_joints,
+            },
+            &params,
+            &mut |stage| progress(stage.name()),
+        )
+        .map_err(|source| JobError::Skin {
+            path: character.path.clone(),
+            source,
+        })?;
+        let mut timings = stage_timings(&skinned);
+
+        progress("writing");
+        let start = Instant::now();
+        let options = WriteOptions {
+            max_influences: params.max_influences,
+            ..WriteOptions::default()
+        };
+        let glb = skinned_glb(&character, &skinned.weights, &options, &outputs.glb)?;
+        plan.write(&outputs.glb, &glb)?;
+        timings.insert("write".into(), json!(start.elapsed().as_secs_f64() * 1e3));
+
+        let input_name = character.path.display().to_string();
+        let report = skin_report(&input_name, &character.warnings, &skinned, timings);
+        if let Some(path) = &outputs.report {
+            let text = serde_json::to_string_pretty(&report).map_err(JobError::Report)?;
+            plan.write(path, text.as_bytes())?;
+        }
+        if let Some(path) = &outputs.rig_info {
+            let pruned = skinned.weights.pruned(params.max_influences);
+            let text = atlas_skin_io::rig_info::to_text(&skeleton, &pruned, &character.file_vertex);
+            plan.write(path, text.as_bytes())?;
+        }
+        if let Some(path) = &outputs.debug_glb {
+            let bytes = debug_view(&skinned, path).map_err(|source| JobError::DebugView {
+                path: path.clone(),
+                source,
+            })?;
+            plan.write(path, &bytes)?;
+        }
+        if let Some(path) = &outputs.html {
+            write_html(&glb, Some(&report), path, &plan)?;
+        }
+        let d = skinned.decomposition.report();
+        let summary = format!(
+            "{}: {} vertices, {} joints ({} cut, {} soft, {} skipped), {} regions -> {}",
+            input_name,
+            skinned.counts.stored_vertices,
+            skinned.counts.joints,
+            d.cuts,
+            d.soft,
+            d.skipped,
+            skinned.decomposition.regions.len(),
+            outputs.glb.display()
+        );
+        Ok(JobOutcome {
+            report,
+            method_warnings: skinned.warnings,
+            summary,
+        })
+    }
+}
+
+/// The debug view (a glb): the split surface coloured by region, the cut curves as lines.
+fn debug_view(skinned: &Skinned, path: &Path) -> Result<Vec<u8>, IoError> {
+    let d = &skinned.decomposition;
+    let positions: Vec<Vec3> = d.surface.positions.iter().map(|p| p.as_vec3()).collect();
+    let lines: Vec<[Vec3; 2]> = debug_lines(d)
+        .iter()
+        .map(|[a, b]| [Vec3::from_array(*a), Vec3::from_array(*b)])
+        .collect();
+    debug_glb(
+        &positions,
+        &d.surface.triangles,
+        &debug_colors(d),
+        &lines,
+        [0.0, 0.0, 0.0, 1.0],
+        path,
+    )
+}

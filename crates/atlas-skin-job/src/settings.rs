@@ -1,0 +1,138 @@
+//! The method's settings for one job: a settings file ([`SkinParams`] as JSON, any subset),
+//! then the options given beside it, which override it.
+
+use atlas_skin::pipeline::SkinParams;
+use atlas_skin::weights::blend::Blend;
+use atlas_skin_io::gltf::MAX_INFLUENCES;
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// What is wrong with a settings file or an option.
+#[derive(Debug, Error)]
+pub enum SettingsError {
+    #[error("cannot read {}", path.display())]
+    Read {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{} is not a valid settings file", path.display())]
+    Parse {
+        path: PathBuf,
+        #[source]
+        source: serde_json::Error,
+    },
+    #[error("{}: max_influences {value} is outside 1..={MAX_INFLUENCES}", path.display())]
+    FileMaxInfluences { path: PathBuf, value: usize },
+    #[error("max_influences {value} is outside 1..={MAX_INFLUENCES}")]
+    MaxInfluences { value: usize },
+}
+
+/// The settings of a job: each field left empty keeps the settings file's value, or the
+/// method's default.
+#[derive(Debug, Clone, Default)]
+pub struct Settings {
+    /// A settings file: [`SkinParams`] as JSON (any subset of `decompose`, `overlap`
+    /// {`factor`, `per_joint`}, `blend`, `max_influences`).
+    pub config: Option<PathBuf>,
+    /// Overlap half-width as a multiple of each boundary's diameter.
+    pub overlap: Option<f64>,
+    /// Overlap factor of single joints, by name.
+    pub overlap_joints: Vec<(String, f64)>,
+    /// How overlapping regions are blended.
+    pub blend: Option<Blend>,
+    /// Joints given a boundary even where the rules would not.
+    pub force: Vec<String>,
+    /// Joints given no boundary.
+    pub forbid: Vec<String>,
+    /// Influences kept per vertex, `1..=`[`MAX_INFLUENCES`].
+    pub max_influences: Option<usize>,
+}
+
+impl Settings {
+    /// The files these settings read (the settings file).
+    pub fn paths(&self) -> impl Iterator<Item = &Path> {
+        self.config.as_deref().into_iter()
+    }
+
+    /// The method's parameters: the settings file's (or the defaults), then the options.
+    pub fn params(&self) -> Result<SkinParams, SettingsError> {
+        let mut params: SkinParams = match &self.config {
+            Some(path) => {
+                let text = std::fs::read_to_string(path).map_err(|source| SettingsError::Read {
+                    path: path.clone(),
+                    source,
+                })?;
+                serde_json::from_str(&text).map_err(|source| SettingsError::Parse {
+                    path: path.clone(),
+                    source,
+                })?
+            }
+            None => SkinParams::default(),
+        };
+        if let Some(factor) = self.overlap {
+            params.overlap.factor = factor;
+        }
+        for (name, factor) in &self.overlap_joints {
+            params.overlap.per_joint.insert(name.clone(), *factor);
+        }
+        if let Some(blend) = self.blend {
+            params.blend = blend;
+        }
+        if let Some(n) = self.max_influences {
+            params.max_influences = n;
+        }
+        if !(1..=MAX_INFLUENCES).contains(&params.max_influences) {
+            let value = params.max_influences;
+            return Err(match (&self.config, self.max_influences) {
+                (Some(path), None) => SettingsError::FileMaxInfluences {
+                    path: path.clone(),
+                    value,
+                },
+                _ => SettingsError::MaxInfluences { value },
+            });
+        }
+        params.decompose.force.extend(self.force.iter().cloned());
+        params.decompose.forbid.extend(self.forbid.iter().cloned());
+        Ok(params)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn options_override_the_defaults() {
+        let settings = Settings {
+            overlap: Some(0.25),
+            overlap_joints: vec![("elbow".into(), 0.1)],
+            blend: Some(Blend::Paper),
+            force: vec!["neck".into()],
+            max_influences: Some(2),
+            ..Settings::default()
+        };
+        let params = settings.params().unwrap();
+        assert_eq!(params.overlap.factor, 0.25);
+        assert_eq!(params.overlap.per_joint["elbow"], 0.1);
+        assert_eq!(params.blend, Blend::Paper);
+        assert_eq!(params.max_influences, 2);
+        assert!(params.decompose.force.contains(&"neck".to_string()));
+        assert_eq!(Settings::default().params().unwrap(), SkinParams::default());
+    }
+
+    #[test]
+    fn influences_outside_the_writer_range_are_refused() {
+        for n in [0, MAX_INFLUENCES + 1] {
+            let settings = Settings {
+                max_influences: Some(n),
+                ..Settings::default()
+            };
+            let message = settings.params().unwrap_err().to_string();
+            assert_eq!(
+                message,
+                format!("max_influences {n} is outside 1..={MAX_INFLUENCES}")
+            );
+        }
+    }
+}

@@ -1,0 +1,162 @@
+"""Type stubs of atlas_skin's native module (crates/atlas-skin-py/src/lib.rs)."""
+
+from os import PathLike
+from typing import Any, Dict, Mapping, Optional, Sequence, Tuple, TypedDict, Union
+
+import numpy as np
+import numpy.typing as npt
+from typing_extensions import Unpack
+
+__version__: str
+
+StrPath = Union[str, "PathLike[str]"]
+FloatArray = npt.ArrayLike
+"""float32 or float64 values (a numpy array or anything ``numpy.asarray`` takes)."""
+IntArray = npt.ArrayLike
+"""integer values of any integer dtype."""
+
+class MethodOptions(TypedDict, total=False):
+    """The method's options, taken as keyword arguments by ``compute_weights``,
+    ``skin_file`` and ``batch`` (the flags of ``atlas-skin skin``). Each left out or
+    ``None`` keeps the settings file's value, else the method's default; an unknown name
+    raises ``TypeError``.
+
+    - ``overlap``: overlap half-width as a multiple of each boundary's diameter (default
+      0.5, the paper's): small is quasi-rigid, large is soft (``--overlap``).
+    - ``overlap_joints``: the overlap factor of single joints, by name
+      (``--overlap-joint NAME=F``).
+    - ``blend``: ``"pou"`` (default: the normalised partition of unity, continuous
+      everywhere) or ``"paper"`` (the paper's Eq. 1) (``--blend``).
+    - ``force``: joint names given a boundary (a cut) even where the rules would not
+      (``--force``).
+    - ``forbid``: joint names given no boundary: their part moves with the parent's
+      (``--forbid``).
+    - ``max_influences``: influences kept per vertex, the largest, renormalised (1..=32,
+      default 4) (``--max-influences``).
+    - ``config``: a settings file (``--config``: JSON, any subset of ``decompose``,
+      ``overlap`` {``factor``, ``per_joint``}, ``blend``, ``max_influences``), which the
+      options above override.
+    """
+
+    overlap: Optional[float]
+    overlap_joints: Optional[Mapping[str, float]]
+    blend: Optional[str]
+    force: Optional[Sequence[str]]
+    forbid: Optional[Sequence[str]]
+    max_influences: Optional[int]
+    config: Optional[StrPath]
+
+def compute_weights(
+    vertices: FloatArray,
+    triangles: IntArray,
+    joint_positions: FloatArray,
+    parents: IntArray,
+    *,
+    tails: Optional[FloatArray] = None,
+    names: Optional[Sequence[str]] = None,
+    end_joints: Optional[Sequence[int]] = None,
+    **options: Unpack[MethodOptions],
+) -> Tuple[npt.NDArray[np.uint32], npt.NDArray[np.float32], Dict[str, Any]]:
+    """Skinning weights of a mesh for a skeleton (the method of ``atlas-skin skin``).
+
+    Arrays (the mesh and the skeleton in one space, the bind pose; any unit):
+
+    - ``vertices``: ``(V, 3)`` float32 or float64 positions, as stored (seams may be
+      split: coincident vertices are welded for the method and get equal weights).
+    - ``triangles``: ``(F, 3)`` integer vertex indices, each in ``0..V``.
+    - ``joint_positions``: ``(J, 3)`` floats, the joints' bind positions (a Blender bone's
+      head).
+    - ``parents``: ``(J,)`` integers, the parent joint of each joint, ``-1`` for a root.
+
+    Options:
+
+    - ``tails``: ``(J, 3)`` floats, the far end of each joint's bone (a Blender bone's
+      tail); a row of NaN means none. Only leaf joints use it: their bone runs from the
+      joint to its tail (without one, it continues the parent's bone by half its length).
+    - ``names``: ``J`` unique joint names (default ``joint0``, ``joint1``, ...): the names
+      that ``overlap_joints``, ``force`` and ``forbid`` use, and that the report shows.
+    - ``end_joints``: joints that move nothing (the leaves of a TGF skeleton, libigl's
+      handles): given no boundary unless forced.
+    - ``**options``: the method's options (``MethodOptions``: ``overlap``,
+      ``overlap_joints``, ``blend``, ``force``, ``forbid``, ``max_influences``,
+      ``config``).
+
+    Returns ``(indices, weights, report)``: ``(V, K)`` uint32 joint indices and ``(V, K)``
+    float32 weights with ``K = max_influences``, each row summing to 1, unused slots joint
+    0 with weight 0; and the JSON report of ``atlas-skin skin --report`` as a dict
+    (decomposition, counts, timings, warnings).
+
+    Raises ``ValueError`` for a wrong shape or dtype, a value that is not finite, an
+    index out of range, an invalid skeleton (a cycle), or input the method refuses (the
+    message of the command line, e.g. ``cannot skin the given arrays: ...``);
+    ``FileNotFoundError`` for a missing ``config``.
+    """
+
+def load(
+    path: StrPath,
+    *,
+    skeleton: Optional[StrPath] = None,
+    group: Optional[str] = None,
+    weights: Optional[StrPath] = None,
+) -> Dict[str, Any]:
+    """Reads a character file (glTF/glb/vrm, FBX, OBJ/OFF/PLY/STL/MEDIT with ``skeleton``).
+
+    ``skeleton``: a skeleton file for a bare mesh (.tgf, .bvh, .mhskel, .json, RigNet's
+    ``_rig.txt``); ``group``: only this OBJ group; ``weights``: reference weights for a
+    mesh without them (.dmat, .mhw).
+
+    Returns a dict:
+
+    - ``path``: str; ``warnings``: list of str (what the reader noticed).
+    - ``positions``: ``(V, 3)`` float32; ``triangles``: ``(F, 3)`` uint32.
+    - ``names``: list of ``J`` str; ``parents``: ``(J,)`` int64, ``-1`` for roots;
+      ``joint_positions``: ``(J, 3)`` float32; ``tails``: ``(J, 3)`` float32, NaN rows
+      where the file gives no tail; ``inverse_bind``: ``(J, 4, 4)`` float32 (``M[row,
+      column]``, acting on column vectors); ``end_joints``: list of int. Empty when the
+      file has no skeleton.
+    - ``indices``, ``weights``: the file's own (reference) weights as ``(V, K)`` uint32 and
+      float32 arrays (``K``: the most influences of any vertex), or None.
+
+    ``compute_weights(c["positions"], c["triangles"], c["joint_positions"], c["parents"],
+    tails=c["tails"], names=c["names"], end_joints=c["end_joints"])`` gives the weights of
+    ``atlas-skin skin`` on the same file.
+
+    Raises ``FileNotFoundError`` for a missing file, ``ValueError`` for any other problem
+    (the message names the file).
+    """
+
+def demo() -> Dict[str, Any]:
+    """The built-in demo character (a closed humanoid with hands and feet, no weights), as
+    ``load`` returns a file."""
+
+def deform(
+    positions: FloatArray,
+    indices: IntArray,
+    weights: FloatArray,
+    palette: FloatArray,
+    method: str,
+) -> npt.NDArray[np.float32]:
+    """``deform_lbs`` (``method="lbs"``) or ``deform_dqs`` (``"dqs"``)."""
+
+def skin_file(
+    input: StrPath,
+    output: StrPath,
+    *,
+    report: Optional[StrPath] = None,
+    html: Optional[StrPath] = None,
+    debug_glb: Optional[StrPath] = None,
+    rig_info: Optional[StrPath] = None,
+    skeleton: Optional[StrPath] = None,
+    group: Optional[str] = None,
+    weights: Optional[StrPath] = None,
+    **options: Unpack[MethodOptions],
+) -> Dict[str, Any]:
+    """The job of ``atlas-skin skin INPUT -o OUTPUT``: reads the character, computes its
+    weights and writes the skinned glb ``output`` (and, when given, the JSON ``report``,
+    the ``html`` report, the ``debug_glb`` view and the ``rig_info`` text), each written to
+    a temporary file and renamed, never over an input. ``skeleton``, ``group``,
+    ``weights`` as ``load``; the method's options as ``compute_weights``.
+
+    Returns the report (a dict, as ``report`` holds it). Raises ``FileNotFoundError`` for a
+    missing input, ``ValueError`` with the command line's message for anything else.
+    """

@@ -1,0 +1,40 @@
+//! Rust errors as Python exceptions, with the message the command line prints: a missing
+//! input file raises `FileNotFoundError`, any other bad input `ValueError`; a panic (a bug)
+//! is caught before it reaches Python and raised as `RuntimeError`.
+
+use atlas_skin_io::IoError;
+use atlas_skin_job::{error_chain, JobError, SettingsError};
+use pyo3::exceptions::{PyFileNotFoundError, PyRuntimeError, PyValueError};
+use pyo3::PyErr;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+/// `error` as a Python exception (see the module documentation).
+pub fn to_py_err(error: &JobError) -> PyErr {
+    let message = error_chain(error);
+    let missing = match error {
+        JobError::Io(IoError::Read { cause, .. }) => cause.kind() == std::io::ErrorKind::NotFound,
+        JobError::Settings(SettingsError::Read { source, .. }) => {
+            source.kind() == std::io::ErrorKind::NotFound
+        }
+        _ => false,
+    };
+    if missing {
+        PyFileNotFoundError::new_err(message)
+    } else {
+        PyValueError::new_err(message)
+    }
+}
+
+/// Runs `work`, turning a panic into an error: no unwinding crosses into Python.
+pub fn no_panic<T>(work: impl FnOnce() -> Result<T, PyErr>) -> Result<T, PyErr> {
+    catch_unwind(AssertUnwindSafe(work)).unwrap_or_else(|payload| {
+        let what = payload
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| payload.downcast_ref::<&str>().copied())
+            .unwrap_or("unknown panic");
+        Err(PyRuntimeError::new_err(format!(
+            "atlas-skin internal error (a bug, please report it): {what}"
+        )))
+    })
+}

@@ -1,0 +1,361 @@
+//! The Python package `atlas_skin` (its native module `atlas_skin._atlas_skin`): the
+//! method on numpy arrays (`compute_weights`), characters read into numpy (`load`, `demo`),
+//! posing (`deform_lbs`, `deform_dqs`), and the file job of `atlas-skin skin`
+//! (`skin_file`). The GIL is released while Rust works; the signatures and their
+//! documentation are in `python/atlas_skin/_atlas_skin.pyi`.
+
+mod arrays;
+mod errors;
+
+use crate::errors::{no_panic, to_py_err};
+use atlas_skin::pipeline::{skin, SkinInput};
+use atlas_skin::weights::blend::Blend;
+use atlas_skin_io::gltf::MAX_INFLUENCES;
+use atlas_skin_io::{Character, LoadOptions};
+use atlas_skin_job::report::{skin_report, stage_timings};
+use atlas_skin_job::{Input, JobError, Outputs, Settings, SkinJob};
+use atlas_skin_runtime::{reference, Skeleton, NO_PARENT};
+use glam::Vec3;
+use numpy::{PyArray1, PyArray2};
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
+use std::collections::{BTreeMap, HashSet};
+use std::path::PathBuf;
+
+/// How the input of `compute_weights` is named in messages and in the report.
+const ARRAYS_NAME: &str = "the given arrays";
+
+/// The method's options, from the keyword arguments that Python passes beside a function's
+/// own (see `MethodOptions` in the stub): a `None` value keeps the settings file's value or
+/// the default; an unknown name is a `TypeError`.
+fn method_settings(options: Option<&Bound<'_, PyDict>>) -> PyResult<Settings> {
+    let mut settings = Settings::default();
+    for (key, value) in options.into_iter().flat_map(|d| d.iter()) {
+        let key: String = key.extract()?;
+        if value.is_none() {
+            continue;
+        }
+        let wrong_type = |e: PyErr| PyTypeError::new_err(format!("{key}: {e}"));
+        match key.as_str() {
+            "config" => settings.config = Some(value.extract().map_err(wrong_type)?),
+            "overlap" => settings.overlap = Some(value.extract().map_err(wrong_type)?),
+            "overlap_joints" => {
+                let map: BTreeMap<String, f64> = value.extract().map_err(wrong_type)?;
+                settings.overlap_joints = map.into_iter().collect();
+            }
+            "blend" => {
+                let name: String = value.extract().map_err(wrong_type)?;
+                settings.blend = Some(match name.as_str() {
+                    "pou" => Blend::PartitionOfUnity,
+                    "paper" => Blend::Paper,
+                    other => {
+                        return Err(PyValueError::new_err(format!(
+                            "blend must be \"pou\" or \"paper\", got {other:?}"
+                        )))
+                    }
+                });
+            }
+            "force" => settings.force = value.extract().map_err(wrong_type)?,
+            "forbid" => settings.forbid = value.extract().map_err(wrong_type)?,
+            "max_influences" => {
+                let n: i64 = value.extract().map_err(wrong_type)?;
+                settings.max_influences = Some(usize::try_from(n).map_err(|_| {
+                    PyValueError::new_err(format!(
+                        "max_influences {n} is outside 1..={MAX_INFLUENCES}"
+                    ))
+                })?);
+            }
+            other => {
+                return Err(PyTypeError::new_err(format!(
+                    "unexpected keyword argument {other:?}"
+                )))
+            }
+        }
+    }
+    Ok(settings)
+}
+
+/// A Python object from JSON (through the `json` module: dicts, lists, str, int, float).
+fn json_object<'py>(py: Python<'py>, value: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
+    py.import("json")?
+        .call_method1("loads", (value.to_string(),))
+}
+
+/// The skeleton of `compute_weights`: positions, parents, optional names and tails.
+fn skeleton_from_arrays(
+    joint_positions: &Bound<'_, PyAny>,
+    parents: &Bound<'_, PyAny>,
+    names: Option<Vec<String>>,
+    tails: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Skeleton> {
+    let positions = arrays::points(joint_positions, "joint_positions", 'J')?;
+    let count = positions.len();
+    let parents = arrays::parents(parents, count)?;
+    let names = match names {
+        Some(names) if names.len() != count => {
+            return Err(PyValueError::new_err(format!(
+                "names has {} entries for {count} joints",
+                names.len()
+            )))
+        }
+        Some(names) => names,
+        None => (0..count).map(|j| format!("joint{j}")).collect(),
+    };
+    let mut seen = HashSet::new();
+    if let Some(name) = names.iter().find(|name| !seen.insert(name.as_str())) {
+        return Err(PyValueError::new_err(format!(
+            "names must be unique: {name:?} is given twice"
+        )));
+    }
+    let invalid = |e| PyValueError::new_err(format!("invalid skeleton: {e}"));
+    let skeleton = Skeleton::from_positions(names, parents, &positions).map_err(invalid)?;
+    match tails {
+        Some(tails) => skeleton
+            .with_tails(arrays::optional_points(tails, "tails", count)?)
+            .map_err(invalid),
+        None => Ok(skeleton),
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+#[pyfunction]
+#[pyo3(signature = (
+    vertices, triangles, joint_positions, parents, *, tails=None, names=None,
+    end_joints=None, **options
+))]
+fn compute_weights<'py>(
+    py: Python<'py>,
+    vertices: &Bound<'py, PyAny>,
+    triangles: &Bound<'py, PyAny>,
+    joint_positions: &Bound<'py, PyAny>,
+    parents: &Bound<'py, PyAny>,
+    tails: Option<&Bound<'py, PyAny>>,
+    names: Option<Vec<String>>,
+    end_joints: Option<Vec<i64>>,
+    options: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let positions = arrays::points(vertices, "vertices", 'V')?;
+    let triangles = arrays::triangles(triangles, positions.len())?;
+    let skeleton = skeleton_from_arrays(joint_positions, parents, names, tails)?;
+    let end_joints = end_joints
+        .unwrap_or_default()
+        .into_iter()
+        .map(|j| {
+            u32::try_from(j)
+                .ok()
+                .filter(|&j| (j as usize) < skeleton.len())
+                .ok_or_else(|| {
+                    PyValueError::new_err(format!(
+                        "end_joints holds {j}, not a joint index below {}",
+                        skeleton.len()
+                    ))
+                })
+        })
+        .collect::<PyResult<Vec<u32>>>()?;
+    let settings = method_settings(options)?;
+    let (weights, report, k) = py.detach(|| {
+        no_panic(|| {
+            let params = settings
+                .params()
+                .map_err(|e| to_py_err(&JobError::Settings(e)))?;
+            let skinned = skin(
+                SkinInput {
+                    positions: &positions,
+                    triangles: &triangles,
+                    skeleton: &skeleton,
+                    end_joints: &end_joints,
+                },
+                &params,
+                &mut |_| {},
+            )
+            .map_err(|source| {
+                to_py_err(&JobError::Skin {
+                    path: ARRAYS_NAME.into(),
+                    source,
+                })
+            })?;
+            let report = skin_report(ARRAYS_NAME, &[], &skinned, stage_timings(&skinned));
+            Ok((skinned.weights, report, params.max_influences))
+        })
+    })?;
+    let (indices, weights) = arrays::weights_arrays(py, &weights, k)?;
+    PyTuple::new(
+        py,
+        [
+            indices.into_any(),
+            weights.into_any(),
+            json_object(py, &report)?,
+        ],
+    )
+}
+
+/// A character's arrays as a dict (see `load` in the stub).
+fn character_dict<'py>(py: Python<'py>, character: &Character) -> PyResult<Bound<'py, PyDict>> {
+    let dict = PyDict::new(py);
+    dict.set_item("path", character.path.display().to_string())?;
+    dict.set_item(
+        "positions",
+        arrays::points_array(py, &character.mesh.positions)?,
+    )?;
+    dict.set_item(
+        "triangles",
+        arrays::rows_array(py, &character.mesh.triangles)?,
+    )?;
+    let empty = Skeleton {
+        names: Vec::new(),
+        parents: Vec::new(),
+        inverse_bind: Vec::new(),
+        tails: Vec::new(),
+    };
+    let skeleton = character.skeleton.as_ref().unwrap_or(&empty);
+    dict.set_item("names", skeleton.names.clone())?;
+    let parents: Vec<i64> = skeleton
+        .parents
+        .iter()
+        .map(|&p| if p == NO_PARENT { -1 } else { i64::from(p) })
+        .collect();
+    dict.set_item("parents", PyArray1::from_vec(py, parents))?;
+    dict.set_item(
+        "joint_positions",
+        arrays::points_array(py, &skeleton.bind_positions())?,
+    )?;
+    let tails: Vec<Vec3> = skeleton
+        .tails
+        .iter()
+        .map(|t| t.unwrap_or(Vec3::NAN))
+        .collect();
+    dict.set_item("tails", arrays::points_array(py, &tails)?)?;
+    dict.set_item(
+        "inverse_bind",
+        arrays::matrices_array(py, &skeleton.inverse_bind)?,
+    )?;
+    dict.set_item("end_joints", character.end_joints.clone())?;
+    match &character.reference_weights {
+        Some(weights) => {
+            let (indices, values) = arrays::weights_arrays(py, weights, weights.max_influences())?;
+            dict.set_item("indices", indices)?;
+            dict.set_item("weights", values)?;
+        }
+        None => {
+            dict.set_item("indices", py.None())?;
+            dict.set_item("weights", py.None())?;
+        }
+    }
+    dict.set_item("warnings", character.warnings.clone())?;
+    Ok(dict)
+}
+
+#[pyfunction]
+#[pyo3(signature = (path, *, skeleton=None, group=None, weights=None))]
+fn load<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    skeleton: Option<PathBuf>,
+    group: Option<String>,
+    weights: Option<PathBuf>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let input = Input {
+        path: Some(path),
+        load: LoadOptions {
+            skeleton,
+            group,
+            weights,
+        },
+    };
+    let character =
+        py.detach(|| no_panic(|| input.load().map_err(|e| to_py_err(&JobError::Io(e)))))?;
+    character_dict(py, &character)
+}
+
+#[pyfunction]
+fn demo(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+    let character = py.detach(|| no_panic(|| Ok(atlas_skin_job::demo_character())))?;
+    character_dict(py, &character)
+}
+
+/// Poses `positions` by linear blend (`method` "lbs") or dual quaternion ("dqs") skinning
+/// (the runtime's reference implementations); `deform_lbs` and `deform_dqs` in Python.
+#[pyfunction]
+fn deform<'py>(
+    py: Python<'py>,
+    positions: &Bound<'py, PyAny>,
+    indices: &Bound<'py, PyAny>,
+    weights: &Bound<'py, PyAny>,
+    palette: &Bound<'py, PyAny>,
+    method: &str,
+) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    type Skinning = fn(&[Vec3], &atlas_skin_runtime::VertexWeights, &[glam::Mat4], &mut [Vec3]);
+    let deform: Skinning = match method {
+        "lbs" => reference::linear_blend_positions,
+        "dqs" => reference::dual_quaternion_positions,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "method must be \"lbs\" or \"dqs\", got {other:?}"
+            )))
+        }
+    };
+    let positions = arrays::points(positions, "positions", 'V')?;
+    let palette = arrays::palette(palette)?;
+    let weights = arrays::vertex_weights(indices, weights, positions.len(), palette.len())?;
+    let posed = py.detach(|| {
+        no_panic(|| {
+            let mut out = vec![Vec3::ZERO; positions.len()];
+            deform(&positions, &weights, &palette, &mut out);
+            Ok(out)
+        })
+    })?;
+    arrays::points_array(py, &posed)
+}
+
+#[allow(clippy::too_many_arguments)]
+#[pyfunction]
+#[pyo3(signature = (
+    input, output, *, report=None, html=None, debug_glb=None, rig_info=None, skeleton=None,
+    group=None, weights=None, **options
+))]
+fn skin_file<'py>(
+    py: Python<'py>,
+    input: PathBuf,
+    output: PathBuf,
+    report: Option<PathBuf>,
+    html: Option<PathBuf>,
+    debug_glb: Option<PathBuf>,
+    rig_info: Option<PathBuf>,
+    skeleton: Option<PathBuf>,
+    group: Option<String>,
+    weights: Option<PathBuf>,
+    options: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let job = SkinJob {
+        input: Input {
+            path: Some(input),
+            load: LoadOptions {
+                skeleton,
+                group,
+                weights,
+            },
+        },
+        settings: method_settings(options)?,
+        outputs: Outputs {
+            glb: output,
+            report,
+            html,
+            debug_glb,
+            rig_info,
+        },
+    };
+    let outcome = py.detach(|| no_panic(|| job.run(&mut |_| {}).map_err(|e| to_py_err(&e))))?;
+    json_object(py, &outcome.report)
+}
+
+#[pymodule]
+fn _atlas_skin(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add_function(wrap_pyfunction!(compute_weights, m)?)?;
+    m.add_function(wrap_pyfunction!(load, m)?)?;
+    m.add_function(wrap_pyfunction!(demo, m)?)?;
+    m.add_function(wrap_pyfunction!(deform, m)?)?;
+    m.add_function(wrap_pyfunction!(skin_file, m)?)?;
+    Ok(())
+}
