@@ -142,7 +142,7 @@ class OBJECT_OT_parent_atlas_skin(bpy.types.Operator):
         return {
             "names": bone_names,
             "overlap": self.overlap,
-            "overlap_joint": bone_factors(self.bone_overlap, bone_names, "Per-Bone Overlap"),
+            "overlap_joints": bone_factors(self.bone_overlap, bone_names, "Per-Bone Overlap"),
             "max_influences": self.max_influences,
             "blend": self.blend.lower(),
             "force": bone_list(self.force, bone_names, "Force Boundaries"),

@@ -8,14 +8,11 @@ Usage: python legacy_addon.py LEGACY.zip ATLAS_SKIN OUT_DIR
 import os
 import subprocess
 import sys
-import tempfile
 
-LEGACY_ZIP, ATLAS_SKIN, OUT = sys.argv[1:4]
-USER = tempfile.mkdtemp(prefix="atlas-skin-blender-legacy-")
-os.environ["BLENDER_USER_RESOURCES"] = USER
+from fresh_user import USER  # first: Blender reads the user folder when bpy is imported
 
-import bpy  # noqa: E402
-from skinned import (  # noqa: E402
+import bpy
+from skinned import (
     check_groups,
     check_matches_cli,
     cli_weights,
@@ -24,6 +21,8 @@ from skinned import (  # noqa: E402
     run_operator,
     strip_weights,
 )
+
+LEGACY_ZIP, ATLAS_SKIN, OUT = sys.argv[1:4]
 
 
 def main():

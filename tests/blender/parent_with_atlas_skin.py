@@ -20,32 +20,33 @@ Workbench render of the posed KayKit character coloured by its weights (the READ
 Usage: python parent_with_atlas_skin.py EXTENSION.zip ATLAS_SKIN DATA_DIR OUT_DIR
 (scripts/test-blender-addon passes them).
 """
+import colorsys
 import os
 import subprocess
 import sys
-import tempfile
 
-EXTENSION_ZIP, ATLAS_SKIN, DATA, OUT = sys.argv[1:5]
-# Blender reads its user folder when bpy is imported: a fresh one, so the extension is
-# installed there and nowhere else.
-USER = tempfile.mkdtemp(prefix="atlas-skin-blender-")
-os.environ["BLENDER_USER_RESOURCES"] = USER
+from fresh_user import USER  # first: Blender reads the user folder when bpy is imported
 
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-from mathutils import Euler  # noqa: E402
-from skinned import (  # noqa: E402
+import bpy
+import numpy as np
+from mathutils import Matrix, Vector
+from skinned import (
     bone_weights,
     check_groups,
     check_matches_cli,
     check_pose,
     cli_weights,
     deforming_names,
+    empty_scene,
     groups_snapshot,
     import_character,
+    import_more,
     run_operator,
     strip_weights,
+    world_positions,
 )
+
+EXTENSION_ZIP, ATLAS_SKIN, DATA, OUT = sys.argv[1:5]
 
 ADDON = "bl_ext.user_default.atlas_skin_blender"
 
@@ -212,54 +213,92 @@ def positions_of_data(armature, obj):
     return to_gltf_axes(local, armature.matrix_world.inverted() @ obj.matrix_world)
 
 
-def render_screenshot(path, png):
-    """The KayKit knight weighted by the add-on, posed, each bone's colour blended by the
-    weights, rendered with Workbench."""
-    armature, meshes = import_character(path)
-    strip_weights(meshes)
-    assert run_operator(armature, meshes) == {"FINISHED"}
-    names = deforming_names(armature)
-    hues = np.linspace(0.0, 1.0, len(names), endpoint=False)
-    rng = np.random.default_rng(3)
-    palette = np.array([hsv(h, 0.65, 0.95) for h in rng.permutation(hues)])
-    for obj in meshes:
-        colours = bone_weights(obj, names) @ palette
-        attribute = obj.data.color_attributes.new("weights", "FLOAT_COLOR", "POINT")
-        rgba = np.concatenate([colours, np.ones((len(colours), 1))], axis=1)
-        attribute.data.foreach_set("color", rgba.ravel())
-        obj.data.color_attributes.active_color = attribute
-    pose = {
-        "upperarm.l": (0, 0, -70), "lowerarm.l": (0, 0, -50), "upperarm.r": (-40, 0, 30),
-        "lowerarm.r": (-60, 0, 0), "upperleg.l": (35, 0, 0), "lowerleg.l": (-60, 0, 0),
-        "upperleg.r": (-25, 0, 0), "head": (10, 25, 0), "spine": (0, 15, 0),
-    }
-    for bone, degrees in pose.items():
-        pose_bone = armature.pose.bones.get(bone)
-        assert pose_bone is not None, f"no bone {bone} in {path}: {names}"
-        pose_bone.rotation_mode = "XYZ"
-        pose_bone.rotation_euler = Euler(np.radians(degrees))
+# Poses of the render: bone -> (axis in the armature's space, degrees), Blender's axes
+# (+Z up, the characters facing -Y, their left arm along +X).
+DEMO_POSE = {
+    "spine": ((0, 1, 0), 6), "head": ((0, 0, 1), 25),
+    "upperarm_l": ((0, 1, 0), 55), "lowerarm_l": ((0, 0, 1), -80),
+    "upperarm_r": ((0, 1, 0), -65), "lowerarm_r": ((0, 0, 1), 45),
+    "upleg_l": ((1, 0, 0), -40), "lowerleg_l": ((1, 0, 0), 65), "upleg_r": ((1, 0, 0), 15),
+}
+KNIGHT_POSE = {
+    "head": ((0, 0, 1), -20), "upperarm.l": ((0, 1, 0), 50), "lowerarm.l": ((0, 0, 1), -70),
+    "upperarm.r": ((0, 1, 0), -20), "lowerarm.r": ((1, 0, 0), -60),
+    "upperleg.l": ((1, 0, 0), -45), "lowerleg.l": ((1, 0, 0), 60), "upperleg.r": ((1, 0, 0), 25),
+}
+
+
+def render_screenshot(png, characters):
+    """The characters (file, pose) side by side, weighted by the add-on (bone tails on,
+    the defaults), posed, each bone's colour blended by the weights, rendered with
+    Workbench."""
+    empty_scene()
+    left = 0.0
+    for path, pose in characters:
+        armature, meshes = import_more(path)
+        strip_weights(meshes)
+        assert run_operator(armature, meshes) == {"FINISHED"}
+        colour_by_weights(armature, meshes)
+        turn_bones(armature, pose)
+        low, high = bounds(meshes)
+        armature.location.x += left - low[0]
+        left += high[0] - low[0] + 0.15 * (high[2] - low[2])
+    bpy.context.view_layer.update()
+    low, high = bounds([o for o in bpy.data.objects if o.type == "MESH" and o.parent])
     scene = bpy.context.scene
     camera = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
     scene.collection.objects.link(camera)
-    camera.location = (2.4, -5.2, 2.2)
-    camera.rotation_euler = Euler(np.radians((78, 0, 25)))
-    camera.data.lens = 55
+    centre, size = Vector((low + high) / 2), high - low
+    scene.render.resolution_x, scene.render.resolution_y = 1200, 800
+    half_width = np.tan(camera.data.angle / 2)  # the wider side (Blender's sensor fit)
+    half_height = half_width * 800 / 1200
+    distance = float(1.05 * max(size[0] / half_width, size[2] / half_height) / 2 + size[1] / 2)
+    camera.location = centre + distance * Vector((0.25, -1.0, 0.2)).normalized()
+    camera.rotation_euler = (centre - camera.location).to_track_quat("-Z", "Y").to_euler()
     scene.camera = camera
+    scene.world = bpy.data.worlds.new("background")
+    scene.world.color = (0.92, 0.92, 0.92)
     scene.render.engine = "BLENDER_WORKBENCH"
     scene.display.shading.light = "STUDIO"
     scene.display.shading.color_type = "VERTEX"
     scene.display.shading.show_cavity = True
-    scene.render.resolution_x, scene.render.resolution_y = 900, 900
-    scene.render.film_transparent = False
     scene.render.filepath = png
     bpy.ops.render.render(write_still=True)
     print(f"render: {png}")
 
 
-def hsv(h, s, v):
-    import colorsys
+def bounds(meshes):
+    """(low, high) corners of the posed meshes' world bounding box."""
+    positions = world_positions(meshes)
+    return positions.min(axis=0), positions.max(axis=0)
 
-    return colorsys.hsv_to_rgb(h, s, v)
+
+def colour_by_weights(armature, meshes):
+    """A point colour attribute: each bone's hue (golden-ratio steps in bone order, so a
+    bone and its neighbours differ) blended by the vertex's weights."""
+    names = deforming_names(armature)
+    palette = np.array([colorsys.hsv_to_rgb((0.618034 * i) % 1.0, 0.6, 0.95) for i in range(len(names))])
+    for obj in meshes:
+        rgb = bone_weights(obj, names) @ palette
+        attribute = obj.data.color_attributes.new("weights", "FLOAT_COLOR", "POINT")
+        attribute.data.foreach_set("color", np.hstack([rgb, np.ones((len(rgb), 1))]).ravel())
+        obj.data.color_attributes.active_color = attribute
+
+
+def turn_bones(armature, pose):
+    """Turns each bone of `pose` about its posed head, parents first."""
+    for bone in armature.data.bones:
+        if bone.name not in pose:
+            continue
+        axis, degrees = pose[bone.name]
+        bpy.context.view_layer.update()
+        pose_bone = armature.pose.bones[bone.name]
+        head = pose_bone.head.copy()
+        about_head = (
+            Matrix.Translation(head) @ Matrix.Rotation(np.radians(degrees), 4, axis) @ Matrix.Translation(-head)
+        )
+        pose_bone.matrix = about_head @ pose_bone.matrix
+    bpy.context.view_layer.update()
 
 
 def main():
@@ -285,7 +324,10 @@ def main():
     check_tails(knight)
     check_errors(demo)
     check_modifiers(demo)
-    render_screenshot(knight, os.path.join(OUT, "blender-addon.png"))
+    render_screenshot(
+        os.path.join(OUT, "blender-addon.png"),
+        [(demo, DEMO_POSE), (knight, KNIGHT_POSE)],
+    )
     print("all checks of the Blender add-on passed")
 
 

@@ -6,7 +6,6 @@ import subprocess
 import bpy
 import numpy as np
 from mathutils import Quaternion
-from scene import the_armature
 
 TOLERANCE = 1e-5
 
@@ -19,8 +18,17 @@ def empty_scene():
 def import_character(path):
     """Empty scene, Blender's glTF import; (armature, its skinned meshes by name)."""
     empty_scene()
+    return import_more(path)
+
+
+def import_more(path):
+    """Blender's glTF import into the scene as it is; (the new armature, its meshes by
+    name), animations cleared and every bone at rest."""
+    before = set(bpy.data.objects)
     bpy.ops.import_scene.gltf(filepath=path)
-    armature = the_armature()
+    armatures = [o for o in bpy.data.objects if o not in before and o.type == "ARMATURE"]
+    assert len(armatures) == 1, f"{path}: {len(armatures)} armatures"
+    armature = armatures[0]
     meshes = sorted(
         (o for o in bpy.data.objects if o.type == "MESH" and o.parent == armature),
         key=lambda o: o.name,
