@@ -6,7 +6,7 @@ Writes into OUT_DIR:
   listed in its manifest, packed and then checked by Blender's own `extension build` and
   `extension validate` (blender_ext.py, from the `bpy` package this Python has, or given
   with --blender-ext);
-- `atlas_skin_blender-VERSION-legacy-PLATFORM.zip`, one per wheel: the same add-on (its
+- `atlas_skin_blender-VERSION-PLATFORM-legacy.zip`, one per wheel: the same add-on (its
   Python files, no manifest) for Preferences > Add-ons > Install legacy add-on, the wheel
   unpacked in its `_vendor/`.
 
@@ -72,7 +72,7 @@ def build_extension(blender_ext_path, blender_ext, out, wheels):
 def build_legacy(blender_ext, out, wheel):
     version = manifest_version()
     platforms = "_".join(p.replace("-", "_") for p in wheel_platforms(blender_ext, wheel))
-    path = out / f"atlas_skin_blender-{version}-legacy-{platforms}.zip"
+    path = out / f"atlas_skin_blender-{version}-{platforms}-legacy.zip"
     with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as archive:
         for source in ADDON_FILES:
             if source.suffix != ".py":
