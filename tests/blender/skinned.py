@@ -5,7 +5,7 @@ import subprocess
 
 import bpy
 import numpy as np
-from mathutils import Quaternion
+from mathutils import Matrix, Quaternion, kdtree
 
 TOLERANCE = 1e-5
 
@@ -51,6 +51,53 @@ def strip_weights(meshes, unparent=False):
             world = obj.matrix_world.copy()
             obj.parent = None
             obj.matrix_world = world
+
+
+def restore_file_numbers(path, armature, meshes):
+    """Gives the imported vertices and bone heads the numbers of the file, as
+    `atlas_skin.load` reads them for `atlas-skin skin`; returns how far Blender's importer
+    had moved them (the largest distance, in the file's units).
+
+    Blender's glTF importer skins each vertex into the bind pose in float32
+    (io_scene_gltf2, `skin_into_bind_pose`) and rebuilds the bones from the joint
+    matrices: on CesiumMan, vertices move by up to 5e-7 and joints by 3e-7. The method is
+    not continuous everywhere (a vertex on a cut plane goes to one side or the other), so
+    the comparison with the command line is made on the file's own numbers. Each vertex
+    and bone is matched to the file's nearest (within 1e-5); the meshes must lie in the
+    armature's space unmoved (the add-on then reads exactly these numbers).
+    """
+    import atlas_skin
+
+    character = atlas_skin.load(path)
+    to_blender = np.array(((1.0, 0.0, 0.0), (0.0, 0.0, -1.0), (0.0, 1.0, 0.0)))
+    file_positions = character["positions"].astype(np.float64) @ to_blender.T
+    file_joints = character["joint_positions"].astype(np.float64) @ to_blender.T
+    tree = kdtree.KDTree(len(file_positions))
+    for i, p in enumerate(file_positions):
+        tree.insert(p, i)
+    tree.balance()
+    moved = 0.0
+    for obj in meshes:
+        identity = Matrix.Identity(4)
+        if obj.parent == armature:
+            unmoved = obj.matrix_parent_inverse @ obj.matrix_basis == identity
+        else:
+            unmoved = obj.matrix_world == identity == armature.matrix_world
+        assert unmoved, f"{obj.name} is not in the armature's space unmoved"
+        for v in obj.data.vertices:
+            _, i, distance = tree.find(v.co)
+            assert distance < 1e-5, f"{path}: vertex {v.index} of {obj.name} is not in the file"
+            moved = max(moved, distance)
+            v.co = file_positions[i]
+    bpy.context.view_layer.objects.active = armature
+    bpy.ops.object.mode_set(mode="EDIT")
+    for bone in armature.data.edit_bones:
+        distance = np.linalg.norm(file_joints - np.array(bone.head), axis=1)
+        assert distance.min() < 1e-5, f"{path}: bone {bone.name} is no joint of the file"
+        moved = max(moved, distance.min())
+        bone.head = file_joints[distance.argmin()]
+    bpy.ops.object.mode_set(mode="OBJECT")
+    return moved
 
 
 def run_operator(armature, meshes, undo=False, **options):
