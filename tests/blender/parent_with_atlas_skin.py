@@ -24,6 +24,7 @@ import colorsys
 import os
 import subprocess
 import sys
+import time
 
 from fresh_user import USER  # first: Blender reads the user folder when bpy is imported
 
@@ -65,6 +66,9 @@ def install_extension():
     assert where.startswith(os.path.realpath(USER)), (
         f"atlas_skin imported from {where}, not from the wheel the extension installed"
     )
+    for menu in (bpy.types.VIEW3D_MT_object_parent, bpy.types.VIEW3D_MT_object_context_menu):
+        drawn = [f.__module__ for f in getattr(menu.draw, "_draw_funcs", [])]
+        assert f"{ADDON}.operator" in drawn, f"{menu.__name__} does not show the operator: {drawn}"
 
 
 def check_character(name, path, unparent):
@@ -72,7 +76,9 @@ def check_character(name, path, unparent):
     armature, meshes = import_character(path)
     strip_weights(meshes, unparent)
     # As Blender's importer leaves the character (measured, not asserted).
+    start = time.perf_counter()
     assert run_operator(armature, meshes, use_tails=False) == {"FINISHED"}
+    seconds = time.perf_counter() - start
     names = deforming_names(armature)
     as_imported = [np.abs(bone_weights(o, names) - cli[o.name][0]).max(axis=1) for o in meshes]
     as_imported = np.concatenate(as_imported)
@@ -100,7 +106,8 @@ def check_character(name, path, unparent):
     meshes = [bpy.data.objects[o] for o in before]
     assert groups_snapshot(meshes) == before, f"{name}: undo did not restore the meshes"
     print(
-        f"{name}: {len(as_imported)} vertices in {len(meshes)} mesh(es), {len(names)} bones: "
+        f"{name}: {len(as_imported)} vertices in {len(meshes)} mesh(es), {len(names)} bones, "
+        f"{seconds:.2f} s: "
         f"groups, same as atlas-skin skin (largest difference {worst:.1e}), pose, second run, "
         f"undo: ok. As imported (vertices and joints moved by up to {moved:.1e} by Blender's "
         f"importer): {(as_imported > TOLERANCE).sum()} vertices differ by more than "
@@ -178,11 +185,15 @@ def check_errors(path):
     bpy.context.collection.objects.link(twin)
     expect_error(armature, [meshes[0], twin], "share the mesh")
     bpy.data.objects.remove(twin)
+    installed = sys.modules["atlas_skin"]
+    sys.modules["atlas_skin"] = None  # import fails as it would without the package
+    expect_error(armature, meshes, "the atlas_skin Python package cannot be imported")
+    sys.modules["atlas_skin"] = installed
     for bone in armature.data.bones:
         bone.use_deform = False
     expect_error(armature, meshes, "has no deforming bone")
     print("errors: no armature, unknown bone, bad per-bone overlap, linked duplicates, "
-          "no deforming bone: refused, scene unchanged")
+          "no atlas_skin package, no deforming bone: refused, scene unchanged")
 
 
 def check_modifiers(path):
