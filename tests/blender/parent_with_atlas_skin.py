@@ -270,9 +270,9 @@ def render_screenshot(png, characters):
     camera = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
     scene.collection.objects.link(camera)
     centre, size = Vector((low + high) / 2), high - low
-    scene.render.resolution_x, scene.render.resolution_y = 1200, 800
+    scene.render.resolution_x, scene.render.resolution_y = 960, 640
     half_width = np.tan(camera.data.angle / 2)  # the wider side (Blender's sensor fit)
-    half_height = half_width * 800 / 1200
+    half_height = half_width * 640 / 960
     distance = float(1.05 * max(size[0] / half_width, size[2] / half_height) / 2 + size[1] / 2)
     camera.location = centre + distance * Vector((0.25, -1.0, 0.2)).normalized()
     camera.rotation_euler = (centre - camera.location).to_track_quat("-Z", "Y").to_euler()
@@ -283,6 +283,8 @@ def render_screenshot(png, characters):
     scene.display.shading.light = "STUDIO"
     scene.display.shading.color_type = "VERTEX"
     scene.display.shading.show_cavity = True
+    scene.render.image_settings.color_mode = "RGB"
+    scene.render.image_settings.compression = 100
     scene.render.filepath = png
     bpy.ops.render.render(write_still=True)
     print(f"render: {png}")
