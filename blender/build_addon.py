@@ -30,9 +30,10 @@ def bundled_blender_ext():
     spec = importlib.util.find_spec("bpy")
     if spec is None or spec.origin is None:
         sys.exit("error: no `bpy` package in this Python; give --blender-ext PATH")
-    found = sorted(pathlib.Path(spec.origin).parent.glob("*/scripts/addons_core/bl_pkg/cli/blender_ext.py"))
+    package = pathlib.Path(spec.origin).parent
+    found = sorted(package.glob("*/scripts/addons_core/bl_pkg/cli/blender_ext.py"))
     if not found:
-        sys.exit(f"error: no blender_ext.py under {pathlib.Path(spec.origin).parent}")
+        sys.exit(f"error: no blender_ext.py under {package}")
     return found[-1]
 
 
@@ -81,7 +82,8 @@ def build_legacy(blender_ext, out, wheel):
         with zipfile.ZipFile(wheel) as packed:
             for item in packed.infolist():
                 if not item.is_dir():
-                    archive.writestr(f"atlas_skin_blender/_vendor/{item.filename}", packed.read(item))
+                    name = f"atlas_skin_blender/_vendor/{item.filename}"
+                    archive.writestr(name, packed.read(item))
     return path
 
 

@@ -15,10 +15,10 @@ class BodyError(Exception):
 
 @dataclass
 class Body:
-    """positions: (V, 3) float64 positions in the armature's space, glTF's axes; triangles: (F, 3) int64
-    indices into positions; ranges: for each mesh object, (object, first, end) of its
-    vertices in positions (its vertex i is row first + i); warnings: what was read
-    differently from what the user sees."""
+    """positions: (V, 3) float64 positions in the armature's space, glTF's axes;
+    triangles: (F, 3) int64 indices into positions; ranges: for each mesh object,
+    (object, first, end) of its vertices in positions (its vertex i is row first + i);
+    warnings: what was read differently from what the user sees."""
 
     positions: np.ndarray
     triangles: np.ndarray
@@ -49,11 +49,11 @@ def rest_state(armature, meshes):
 
 def read_body(depsgraph, armature, meshes, progress=lambda: None):
     """Reads `meshes` (mesh objects) evaluated by `depsgraph` into the space of `armature`
-    (an armature object), to be called inside
-    `rest_state`. A mesh whose modifiers keep its vertices is read as evaluated (shape keys
-    and deforming modifiers applied), as Blender's own automatic weights read it; one whose
-    modifiers change its vertex count is read without them, with a warning, since its
-    weights belong to the mesh's own vertices. Calls `progress` after each mesh."""
+    (an armature object), to be called inside `rest_state`. A mesh whose modifiers keep
+    its vertices is read as evaluated (shape keys and deforming modifiers applied), as
+    Blender's own automatic weights read it; one whose modifiers change its vertex count
+    is read without them, with a warning, since its weights belong to the mesh's own
+    vertices. Calls `progress` after each mesh."""
     check_distinct_data(meshes)
     positions, triangles, ranges, warnings = [], [], [], []
     first = 0

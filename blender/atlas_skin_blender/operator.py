@@ -158,4 +158,6 @@ def draw_parent_menu(self, _context):
 def draw_context_menu(self, context):
     if context.active_object is not None and context.active_object.type == "ARMATURE":
         self.layout.separator()
-        self.layout.operator(OBJECT_OT_parent_atlas_skin.bl_idname, text="Parent with Atlas-Skin Weights")
+        self.layout.operator(
+            OBJECT_OT_parent_atlas_skin.bl_idname, text="Parent with Atlas-Skin Weights"
+        )

@@ -16,8 +16,8 @@ class Rig:
     """Joints of atlas-skin, one per deforming bone.
 
     names: J bone names; heads, tails: (J, 3) float64 positions of each bone's head and
-    tail at rest (the armature's space, glTF's axes); parents: (J,) int64, the index of the nearest deforming
-    ancestor or -1 for a root. Parents come before their children.
+    tail at rest (the armature's space, glTF's axes); parents: (J,) int64, the index of
+    the nearest deforming ancestor or -1 for a root. Parents come before their children.
     """
 
     names: list

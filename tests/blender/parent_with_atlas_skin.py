@@ -92,9 +92,12 @@ def check_character(name, path, unparent):
     check_groups(name, meshes, names)
     worst = check_matches_cli(name, meshes, names, cli_names, cli)
     kept = [
-        (v.index, g.weight) for v in meshes[0].data.vertices for g in v.groups if g.group == keep.index
+        (v.index, g.weight)
+        for v in meshes[0].data.vertices
+        for g in v.groups
+        if g.group == keep.index
     ]
-    assert kept == [(0, 0.25), (1, 0.25), (2, 0.25)], f"{name}: the non-bone group changed: {kept[:5]}"
+    assert kept == [(0, 0.25), (1, 0.25), (2, 0.25)], f"{name}: the group changed: {kept[:5]}"
     for obj in meshes:
         assert obj.parent == armature and obj.parent_type == "OBJECT", f"{name}/{obj.name}: parent"
         assert [(m.type, m.object) for m in obj.modifiers] == [("ARMATURE", armature)]
@@ -130,8 +133,11 @@ def check_options(path):
     cases = [
         ({"max_influences": 2}, ["--max-influences", "2"]),
         ({"blend": "PAPER"}, ["--blend", "paper"]),
-        ({"overlap": 0.25, "bone_overlap": "lowerarm_l=1.5, upleg_r = 0.1"},
-         ["--overlap", "0.25", "--overlap-joint", "lowerarm_l=1.5", "--overlap-joint", "upleg_r=0.1"]),
+        (
+            {"overlap": 0.25, "bone_overlap": "lowerarm_l=1.5, upleg_r = 0.1"},
+            ["--overlap", "0.25", "--overlap-joint", "lowerarm_l=1.5", "--overlap-joint",
+             "upleg_r=0.1"],
+        ),
         ({"force": "head", "forbid": "lowerleg_l, hand_r"},
          ["--force", "head", "--forbid", "lowerleg_l", "--forbid", "hand_r"]),
     ]
@@ -300,7 +306,8 @@ def colour_by_weights(armature, meshes):
     """A point colour attribute: each bone's hue (golden-ratio steps in bone order, so a
     bone and its neighbours differ) blended by the vertex's weights."""
     names = deforming_names(armature)
-    palette = np.array([colorsys.hsv_to_rgb((0.618034 * i) % 1.0, 0.6, 0.95) for i in range(len(names))])
+    hues = (0.618034 * np.arange(len(names))) % 1.0
+    palette = np.array([colorsys.hsv_to_rgb(h, 0.6, 0.95) for h in hues])
     for obj in meshes:
         rgb = bone_weights(obj, names) @ palette
         attribute = obj.data.color_attributes.new("weights", "FLOAT_COLOR", "POINT")
@@ -317,9 +324,8 @@ def turn_bones(armature, pose):
         bpy.context.view_layer.update()
         pose_bone = armature.pose.bones[bone.name]
         head = pose_bone.head.copy()
-        about_head = (
-            Matrix.Translation(head) @ Matrix.Rotation(np.radians(degrees), 4, axis) @ Matrix.Translation(-head)
-        )
+        turn = Matrix.Rotation(np.radians(degrees), 4, axis)
+        about_head = Matrix.Translation(head) @ turn @ Matrix.Translation(-head)
         pose_bone.matrix = about_head @ pose_bone.matrix
     bpy.context.view_layer.update()
 

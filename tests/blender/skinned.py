@@ -194,7 +194,8 @@ def check_pose(name, armature, meshes, names):
         outside = moved[subtree == 0]
         assert outside.size == 0 or outside.max() < 1e-5 * diagonal, (
             f"{name}: turning {bone_name} moves vertices it does not weight "
-            f"({(outside >= 1e-5 * diagonal).sum()}, by up to {outside.max() / diagonal:.2g} diagonals)"
+            f"({(outside >= 1e-5 * diagonal).sum()}, "
+            f"by up to {outside.max() / diagonal:.2g} diagonals)"
         )
         part = moved[subtree > 1 - 1e-6]
         if part.size:
