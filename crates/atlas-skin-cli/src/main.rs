@@ -23,6 +23,8 @@ enum Command {
     Inspect(cmd::inspect::Args),
     /// Compute skinning weights and write a skinned glTF binary (the main job).
     Skin(cmd::skin::Args),
+    /// Skin many characters at once: files, folders, globs, to OUTDIR/<name>.glb.
+    Batch(cmd::batch::Args),
     /// Write the project's own demo character (a closed humanoid with its skeleton).
     Demo(cmd::demo::Args),
     /// Pose a skinned character and write the deformed mesh.
@@ -42,6 +44,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Inspect(args) => cmd::inspect::run(args),
         Command::Skin(args) => cmd::skin::run(args),
+        Command::Batch(args) => cmd::batch::run(args),
         Command::Demo(args) => cmd::demo::run(args),
         Command::Pose(args) => cmd::pose::run(args),
         Command::Animate(args) => cmd::animate::run(args),

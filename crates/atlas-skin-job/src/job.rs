@@ -133,7 +133,8 @@ impl Outputs {
         }
     }
 
-    fn paths(&self) -> impl Iterator<Item = &Path> {
+    /// Every file written.
+    pub fn paths(&self) -> impl Iterator<Item = &Path> {
         [
             Some(&self.glb),
             self.report.as_ref(),

@@ -1,7 +1,7 @@
 //! The Python package `atlas_skin` (its native module `atlas_skin._atlas_skin`): the
 //! method on numpy arrays (`compute_weights`), characters read into numpy (`load`, `demo`),
-//! posing (`deform_lbs`, `deform_dqs`), and the file job of `atlas-skin skin`
-//! (`skin_file`). The GIL is released while Rust works; the signatures and their
+//! posing (`deform_lbs`, `deform_dqs`), the file job of `atlas-skin skin` (`skin_file`)
+//! and of `atlas-skin batch` (`batch`). The GIL is released while Rust works; the signatures and their
 //! documentation are in `python/atlas_skin/_atlas_skin.pyi`.
 
 mod arrays;
@@ -12,8 +12,9 @@ use atlas_skin::pipeline::{skin, SkinInput};
 use atlas_skin::weights::blend::Blend;
 use atlas_skin_io::gltf::MAX_INFLUENCES;
 use atlas_skin_io::{Character, LoadOptions};
+use atlas_skin_job::batch::{collect_inputs, plan_jobs, run_batch, BatchError, BatchOptions};
 use atlas_skin_job::report::{skin_report, stage_timings};
-use atlas_skin_job::{Input, JobError, Outputs, Settings, SkinJob};
+use atlas_skin_job::{error_chain, Input, JobError, Outputs, Settings, SkinJob};
 use atlas_skin_runtime::{reference, Skeleton, NO_PARENT};
 use glam::Vec3;
 use numpy::{PyArray1, PyArray2};
@@ -349,6 +350,50 @@ fn skin_file<'py>(
     json_object(py, &outcome.report)
 }
 
+#[allow(clippy::too_many_arguments)]
+#[pyfunction]
+#[pyo3(signature = (
+    inputs, out_dir, *, jobs=None, resume=false, report=false, html=false, log=None, **options
+))]
+fn batch<'py>(
+    py: Python<'py>,
+    inputs: &Bound<'py, PyAny>,
+    out_dir: PathBuf,
+    jobs: Option<usize>,
+    resume: bool,
+    report: bool,
+    html: bool,
+    log: Option<PathBuf>,
+    options: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let inputs: Vec<PathBuf> = match inputs.extract::<PathBuf>() {
+        Ok(one) => vec![one],
+        Err(_) => inputs.extract()?,
+    };
+    let options = BatchOptions {
+        out_dir,
+        jobs: jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
+        resume,
+        report,
+        html,
+        log,
+        settings: method_settings(options)?,
+    };
+    if options.jobs == 0 {
+        return Err(PyValueError::new_err("jobs must be at least 1"));
+    }
+    let result = py.detach(|| {
+        no_panic(|| {
+            let refused = |e: BatchError| PyValueError::new_err(error_chain(&e));
+            let files = collect_inputs(&inputs).map_err(refused)?;
+            let jobs = plan_jobs(&files, &options).map_err(refused)?;
+            let (records, summary) = run_batch(&jobs, &options, &|_| {}).map_err(refused)?;
+            Ok(serde_json::json!({"records": records, "summary": summary}))
+        })
+    })?;
+    json_object(py, &result)
+}
+
 #[pymodule]
 fn _atlas_skin(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
@@ -357,5 +402,6 @@ fn _atlas_skin(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(demo, m)?)?;
     m.add_function(wrap_pyfunction!(deform, m)?)?;
     m.add_function(wrap_pyfunction!(skin_file, m)?)?;
+    m.add_function(wrap_pyfunction!(batch, m)?)?;
     Ok(())
 }

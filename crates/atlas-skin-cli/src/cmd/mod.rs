@@ -1,6 +1,7 @@
 //! One module per subcommand, each with its `Args` and `run`.
 
 pub mod animate;
+pub mod batch;
 pub mod bench;
 pub mod demo;
 pub mod eval;

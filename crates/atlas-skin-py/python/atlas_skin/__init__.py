@@ -9,6 +9,7 @@ Thibert, INRIA RR-6406, 2008, with the extensions of the atlas-skin project).
 - ``deform_lbs`` / ``deform_dqs``: pose vertices with linear blend or dual quaternion
   skinning.
 - ``skin_file``: the job of ``atlas-skin skin`` (a character file to a skinned glb).
+- ``batch``: the job of ``atlas-skin batch`` (many files, several at a time, a log).
 
 Bad input raises ``ValueError`` (``FileNotFoundError`` for a missing file) with the
 message the command line prints. The GIL is released while the Rust code works.
@@ -19,7 +20,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ._atlas_skin import __version__, compute_weights, deform, demo, load, skin_file
+from ._atlas_skin import __version__, batch, compute_weights, deform, demo, load, skin_file
 
 
 def deform_lbs(positions: Any, indices: Any, weights: Any, palette: Any) -> npt.NDArray[np.float32]:
@@ -44,6 +45,7 @@ def deform_dqs(positions: Any, indices: Any, weights: Any, palette: Any) -> npt.
 
 __all__ = [
     "__version__",
+    "batch",
     "compute_weights",
     "deform_dqs",
     "deform_lbs",

@@ -160,3 +160,33 @@ def skin_file(
     Returns the report (a dict, as ``report`` holds it). Raises ``FileNotFoundError`` for a
     missing input, ``ValueError`` with the command line's message for anything else.
     """
+
+def batch(
+    inputs: Union[StrPath, Sequence[StrPath]],
+    out_dir: StrPath,
+    *,
+    jobs: Optional[int] = None,
+    resume: bool = False,
+    report: bool = False,
+    html: bool = False,
+    log: Optional[StrPath] = None,
+    **options: Unpack[MethodOptions],
+) -> Dict[str, Any]:
+    """The job of ``atlas-skin batch INPUT... -o OUT_DIR``: every character of ``inputs``
+    (files; folders, searched with their subfolders for .glb, .gltf, .vrm and .fbx files;
+    glob patterns such as ``"chars/*.fbx"``) skinned to ``OUT_DIR/<name>.glb`` (with
+    ``<name>.json`` when ``report``, ``<name>.html`` when ``html``), ``jobs`` files at a
+    time (default: the number of cores). ``resume`` skips the files whose outputs exist
+    and are newer than the file and the ``config``. A failing file does not stop the
+    others. Each finished file appends a record to the JSON-lines ``log`` (default
+    ``OUT_DIR/atlas-skin-batch.jsonl``). The method's options as ``compute_weights``.
+
+    Returns ``{"records": [...], "summary": {...}}``: one record per file, in the order
+    of the inputs (``input``, ``output``, ``status``: ``"ok"``, ``"failed"`` or
+    ``"skipped"``, ``error``: the message ``skin`` would print or None, ``seconds``,
+    ``timings_ms``, ``counts``, ``warnings``), and the totals (``files``, ``ok``,
+    ``failed``, ``skipped``, ``seconds``, ``characters_per_second``, ``log``). A failed
+    file is in the records, not raised. Raises ``ValueError`` when the batch cannot start
+    (a pattern matching nothing, a folder without character files, two inputs with one
+    name, an output over an input).
+    """
