@@ -100,11 +100,16 @@ def restore_file_numbers(path, armature, meshes):
     return moved
 
 
-def run_operator(armature, meshes, undo=False, **options):
+def select(armature, meshes):
+    """Selects the meshes and the armature, the armature active (as Ctrl+P wants them)."""
     bpy.ops.object.select_all(action="DESELECT")
     for obj in [armature, *meshes]:
         obj.select_set(True)
     bpy.context.view_layer.objects.active = armature
+
+
+def run_operator(armature, meshes, undo=False, **options):
+    select(armature, meshes)
     return bpy.ops.object.parent_atlas_skin("EXEC_DEFAULT", undo, **options)
 
 
