@@ -71,7 +71,10 @@ def read_body(depsgraph, armature, meshes, progress=lambda: None):
             local, tris = mesh_arrays(mesh)
         finally:
             evaluated.to_mesh_clear()
-        positions.append(to_gltf_axes(local, armature_from_object(armature, obj, evaluated)))
+        to_armature = armature_from_object(armature, obj, evaluated)
+        if to_armature.determinant() < 0.0:
+            tris = tris[:, ::-1]  # a mirroring transform turns the surface inside out
+        positions.append(to_gltf_axes(local, to_armature))
         triangles.append(tris + first)
         ranges.append((obj, first, first + count))
         first += count

@@ -239,6 +239,13 @@ def check_modifiers(path):
     assert not evaluated.warnings, evaluated.warnings
     moved = np.abs(evaluated.positions - positions_of_data(armature, body)).max()
     assert abs(moved - 0.01) < 1e-3, f"shape key not read: moved by {moved}"
+    assert signed_volume(evaluated) > 0, "the demo read inside out"
+    body.scale.x = -1.0  # a mirrored object: its triangles are turned so the body faces out
+    bpy.context.view_layer.update()
+    with rest_state(armature, meshes):
+        mirrored = read_body(bpy.context.evaluated_depsgraph_get(), armature, meshes)
+    assert signed_volume(mirrored) > 0, "a mirrored mesh read inside out"
+    body.scale.x = 1.0
     body.modifiers.new(name="Subdivision", type="SUBSURF")
     with rest_state(armature, meshes):
         base = read_body(bpy.context.evaluated_depsgraph_get(), armature, meshes)
@@ -247,8 +254,14 @@ def check_modifiers(path):
     assert run_operator(armature, meshes) == {"FINISHED"}
     assert [m.type for m in body.modifiers] == ["ARMATURE", "SUBSURF"], "Armature not first"
     check_groups("demo with a shape key and a Subdivision", meshes, deforming_names(armature))
-    print("modifiers: shape key read evaluated, Subdivision left out with a warning, "
-          "Armature modifier first")
+    print("modifiers: shape key read evaluated, a mirrored object read facing out, "
+          "Subdivision left out with a warning, Armature modifier first")
+
+
+def signed_volume(body):
+    """Volume enclosed by the body's triangles, positive when they face outward."""
+    a, b, c = (body.positions[body.triangles[:, k]] for k in range(3))
+    return np.einsum("ij,ij->", a, np.cross(b, c)) / 6.0
 
 
 def positions_of_data(armature, obj):
