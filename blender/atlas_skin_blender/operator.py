@@ -1,0 +1,163 @@
+"""Object > Parent > With Atlas-Skin Weights: the selected meshes, as one body, weighted
+to the selected armature by atlas-skin."""
+import time
+
+import bpy
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
+
+from .binding import bind_to_armature, write_groups
+from .body import BodyError, read_body, rest_state
+from .options import OptionError, bone_factors, bone_list
+from .package import MissingPackage, atlas_skin
+from .rig import RigError, deforming_rig
+
+
+def selection(context):
+    """(armature, meshes) of the selection, or a sentence saying what is missing."""
+    selected = context.selected_objects
+    armatures = [o for o in selected if o.type == "ARMATURE"]
+    meshes = [o for o in selected if o.type == "MESH"]
+    if len(armatures) != 1:
+        return f"select one armature ({len(armatures)} selected) and the meshes to weight"
+    if not meshes:
+        return "select the meshes to weight together with the armature"
+    return armatures[0], meshes
+
+
+class OBJECT_OT_parent_atlas_skin(bpy.types.Operator):
+    """Parent the selected meshes to the selected armature with weights computed by
+    atlas-skin: one vertex group per deforming bone, an Armature modifier"""
+
+    bl_idname = "object.parent_atlas_skin"
+    bl_label = "With Atlas-Skin Weights"
+    bl_options = {"REGISTER", "UNDO"}
+
+    overlap: FloatProperty(
+        name="Overlap",
+        description="Half-width of the blend between neighbouring parts, as a multiple of "
+        "each boundary's diameter (the paper's 0.5)",
+        default=0.5,
+        min=0.001,
+        soft_max=2.0,
+    )
+    bone_overlap: StringProperty(
+        name="Per-Bone Overlap",
+        description="Overlap of single bones, as BONE=FACTOR, comma-separated: from "
+        "quasi-rigid (small) to soft (large)",
+    )
+    max_influences: IntProperty(
+        name="Max Influences",
+        description="Bones kept per vertex (the largest weights, renormalised)",
+        default=4,
+        min=1,
+        max=32,
+    )
+    blend: EnumProperty(
+        name="Blend",
+        description="How overlapping parts are blended",
+        items=(
+            ("POU", "Partition of Unity", "Normalised partition of unity: continuous everywhere"),
+            ("PAPER", "Paper (Eq. 1)", "The blending of Lu et al. 2008, Eq. 1"),
+        ),
+        default="POU",
+    )
+    force: StringProperty(
+        name="Force Boundaries",
+        description="Bones that get a boundary where the rules would give none "
+        "(comma-separated)",
+    )
+    forbid: StringProperty(
+        name="Forbid Boundaries",
+        description="Bones that get no boundary: their part moves with their parent's "
+        "(comma-separated)",
+    )
+    use_tails: BoolProperty(
+        name="Bone Tails",
+        description="Leaf bones end at their tails (face bones move a patch of skin); off, "
+        "bones are their heads only, as in a glTF file, whose tails Blender's importer guesses",
+        default=True,
+    )
+
+    @classmethod
+    def poll(cls, context):
+        if context.mode != "OBJECT":
+            cls.poll_message_set("works in Object Mode")
+            return False
+        found = selection(context)
+        if isinstance(found, str):
+            cls.poll_message_set(found)
+            return False
+        return True
+
+    def execute(self, context):
+        armature, meshes = selection(context)
+        manager = context.window_manager
+        manager.progress_begin(0, 2 * len(meshes) + 1)
+        steps = iter(range(1, 2 * len(meshes) + 2))
+        try:
+            summary, warnings = self.parent_with_weights(
+                context, armature, meshes, lambda: manager.progress_update(next(steps))
+            )
+        except (MissingPackage, RigError, BodyError, OptionError, ValueError) as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        finally:
+            manager.progress_end()
+        for warning in warnings:
+            self.report({"WARNING"}, warning)
+        self.report({"INFO"}, summary)
+        return {"FINISHED"}
+
+    def parent_with_weights(self, context, armature, meshes, progress):
+        """Computes and writes the weights; returns the summary line and the warnings.
+        Everything that can fail happens before the first change to the scene."""
+        package = atlas_skin()
+        rig = deforming_rig(armature)
+        options = self.method_options(rig.names)
+        with rest_state(armature, meshes):
+            body = read_body(context.evaluated_depsgraph_get(), armature, meshes, progress)
+            start = time.perf_counter()
+            indices, weights, report = package.compute_weights(
+                body.positions,
+                body.triangles,
+                rig.heads,
+                rig.parents,
+                tails=rig.tails if self.use_tails else None,
+                **options,
+            )
+            seconds = time.perf_counter() - start
+            progress()
+            for obj, first, end in body.ranges:
+                write_groups(obj, rig.names, indices[first:end], weights[first:end])
+                bind_to_armature(obj, armature)
+                progress()
+        summary = (
+            f"Atlas-Skin: {len(body.positions)} vertices of {len(meshes)} mesh(es) weighted "
+            f"to {len(rig.names)} bones of '{armature.name}' in {seconds:.2f} s"
+        )
+        return summary, body.warnings + list(report.get("warnings", []))
+
+    def method_options(self, bone_names):
+        """The keyword options of `atlas_skin.compute_weights`."""
+        return {
+            "names": bone_names,
+            "overlap": self.overlap,
+            "overlap_joints": bone_factors(self.bone_overlap, bone_names, "Per-Bone Overlap"),
+            "max_influences": self.max_influences,
+            "blend": self.blend.lower(),
+            "force": bone_list(self.force, bone_names, "Force Boundaries"),
+            "forbid": bone_list(self.forbid, bone_names, "Forbid Boundaries"),
+        }
+
+
+def draw_parent_menu(self, _context):
+    self.layout.operator(OBJECT_OT_parent_atlas_skin.bl_idname)
+    self.layout.separator()
+
+
+def draw_context_menu(self, context):
+    if context.active_object is not None and context.active_object.type == "ARMATURE":
+        self.layout.separator()
+        self.layout.operator(
+            OBJECT_OT_parent_atlas_skin.bl_idname, text="Parent with Atlas-Skin Weights"
+        )
