@@ -268,7 +268,7 @@ impl PlaneSearch<'_> {
             normal: self.basis.normal(alpha, beta),
         };
         let mut best: Option<CutCandidate> = None;
-        for curve in self.domain.closed_sections(self.topology, &plane) {
+        for curve in self.domain.closed_sections(&plane) {
             let points = curve.positions(self.mesh, self.topology);
             if !polygon_contains(&points, plane.normal, plane.point) {
                 continue;

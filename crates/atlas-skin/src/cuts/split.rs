@@ -203,7 +203,7 @@ mod tests {
         );
         let curves: Vec<SectionCurve> = planes
             .iter()
-            .flat_map(|plane| domain.closed_sections(&topology, plane))
+            .flat_map(|plane| domain.closed_sections(plane))
             .collect();
         split_along_curves(mesh, &topology, &curves.iter().collect::<Vec<_>>())
     }

@@ -6,13 +6,14 @@
 //! the doubled demo).
 
 use super::surface::SurfaceMesh;
-use std::collections::HashSet;
+use rustc_hash::FxHashSet;
 
 /// Removes every triangle whose vertex set an earlier triangle already has, keeping the
 /// first (stored order) and the order of the rest; returns how many were removed.
 pub fn remove_duplicate_faces(mesh: &mut SurfaceMesh) -> usize {
     let before = mesh.triangles.len();
-    let mut seen = HashSet::with_capacity(before);
+    let mut seen = FxHashSet::default();
+    seen.reserve(before);
     mesh.triangles.retain(|t| {
         let mut key = *t;
         key.sort_unstable();
