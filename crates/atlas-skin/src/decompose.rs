@@ -14,7 +14,7 @@
 use crate::cuts::conflicts::{place_cuts, Placement};
 use crate::cuts::joint_roles::{plan_joints, JointFrame, JointPlan};
 use crate::cuts::plane_search::{find_cut_candidates, CutCandidate, CutSearch, CutSurface};
-use crate::cuts::plane_section::{diameter, vertex_snap_distances};
+use crate::cuts::plane_section::{diameter, vertex_snap_distances, DomainScratch};
 use crate::cuts::split::split_along_curves;
 use crate::decomposition::{Boundary, BoundaryKind, Decomposition, JointDecision, JointStatus};
 use crate::mesh::{FaceSpheres, SurfaceMesh, Topology};
@@ -265,9 +265,9 @@ fn search_all_cuts(
     plans
         .par_iter()
         .enumerate()
-        .map(|(j, plan)| match plan {
+        .map_init(DomainScratch::default, |scratch, (j, plan)| match plan {
             JointPlan::Boundary(frame) | JointPlan::Soft(frame, _) => {
-                find_cut_candidates(surface, frame, &bones_not_at(&bones, positions, j))
+                find_cut_candidates(surface, frame, &bones_not_at(&bones, positions, j), scratch)
             }
             JointPlan::Skip(_) | JointPlan::Exclude(_) => CutSearch::default(),
         })

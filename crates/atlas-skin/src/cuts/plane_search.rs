@@ -21,7 +21,7 @@
 use super::params::DecomposeParams;
 use crate::cuts::joint_roles::JointFrame;
 use crate::cuts::plane_section::{
-    closed_length, polygon_contains, Plane, SectionCurve, SectionDomain,
+    closed_length, polygon_contains, DomainScratch, Plane, SectionCurve, SectionDomain,
 };
 use crate::geometry::point_segment_distance;
 use crate::mesh::spatial_index::FaceSpheres;
@@ -69,11 +69,13 @@ pub struct CutSearch {
 }
 
 /// Every closed section around the joint of `frame` that no bone of `other_bones` passes
-/// through, found by the search; none when no sampled plane gives one.
+/// through, found by the search; none when no sampled plane gives one. `scratch`: working
+/// memory of the section domains, reused from joint to joint.
 pub fn find_cut_candidates(
     surface: &CutSurface,
     frame: &JointFrame,
     other_bones: &[[DVec3; 2]],
+    scratch: &mut DomainScratch,
 ) -> CutSearch {
     let mut radius =
         surface.params.neighbourhood_factor * frame.surface_distance.max(0.1 * frame.bone_length);
@@ -86,7 +88,7 @@ pub fn find_cut_candidates(
             .filter(|[a, b]| point_segment_distance(frame.position, *a, *b) <= 2.0 * radius)
             .copied()
             .collect();
-        let search = search_within(surface, frame, &near_bones, faces);
+        let search = search_within(surface, frame, &near_bones, faces, scratch);
         if !search.candidates.is_empty() || everything {
             return search;
         }
@@ -102,6 +104,7 @@ fn search_within(
     frame: &JointFrame,
     other_bones: &[[DVec3; 2]],
     faces: Vec<u32>,
+    scratch: &mut DomainScratch,
 ) -> CutSearch {
     let (mesh, topology, params) = (surface.mesh, surface.topology, surface.params);
     let mut search = PlaneSearch {
@@ -110,7 +113,7 @@ fn search_within(
         other_bones,
         enclosing_other_bones: 0,
         position: frame.position,
-        domain: SectionDomain::new(mesh, topology, surface.vertex_snap, faces),
+        domain: SectionDomain::new(mesh, topology, surface.vertex_snap, faces, scratch),
         basis: NormalBasis::new(frame.upper, frame.lower),
     };
     let step = params.angle_step_deg.to_radians();

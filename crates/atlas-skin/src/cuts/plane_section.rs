@@ -12,7 +12,6 @@
 
 use crate::mesh::{SurfaceMesh, Topology};
 use glam::DVec3;
-use rustc_hash::FxHashMap;
 
 /// A plane through `point` with unit `normal`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -107,6 +106,32 @@ pub struct SectionDomain {
     stamp: u32,
 }
 
+/// Maps from the mesh's vertices, edges and faces to a domain's (0, or 1 + the local
+/// index) used while building a [`SectionDomain`]: allocated once per thread for the whole
+/// mesh and cleared entry by entry, so that a domain costs O(its faces).
+#[derive(Debug, Clone, Default)]
+pub struct DomainScratch {
+    vertex: Vec<u32>,
+    edge: Vec<u32>,
+    face: Vec<u32>,
+}
+
+impl DomainScratch {
+    /// Grows the maps to the mesh's sizes (all zero; a zeroed allocation, whose pages the
+    /// system provides as they are first touched).
+    fn fit(&mut self, mesh: &SurfaceMesh, topology: &Topology) {
+        for (map, n) in [
+            (&mut self.vertex, mesh.vertex_count()),
+            (&mut self.edge, topology.edges.len()),
+            (&mut self.face, mesh.triangle_count()),
+        ] {
+            if map.len() < n {
+                *map = vec![0; n];
+            }
+        }
+    }
+}
+
 /// Snap distance of every vertex: `fraction` × its longest incident edge (0 for an isolated
 /// vertex).
 pub fn vertex_snap_distances(mesh: &SurfaceMesh, topology: &Topology, fraction: f64) -> Vec<f64> {
@@ -122,12 +147,14 @@ pub fn vertex_snap_distances(mesh: &SurfaceMesh, topology: &Topology, fraction: 
 
 impl SectionDomain {
     /// A domain of `faces` of `mesh`; faces with a repeated vertex index are left out (a
-    /// curve reaching them is open).
+    /// curve reaching them is open). `scratch` maps the mesh's indices to local ones while
+    /// building and is left clean for the next domain.
     pub fn new(
         mesh: &SurfaceMesh,
         topology: &Topology,
         vertex_snap: &[f64],
         faces: Vec<u32>,
+        scratch: &mut DomainScratch,
     ) -> Self {
         let faces: Vec<u32> = faces
             .into_iter()
@@ -136,44 +163,55 @@ impl SectionDomain {
                 a != b && b != c && a != c
             })
             .collect();
-        let local_face_of: FxHashMap<u32, u32> = faces
-            .iter()
-            .enumerate()
-            .map(|(i, &f)| (f, i as u32))
-            .collect();
-        let mut local_vertex_of: FxHashMap<u32, u32> = FxHashMap::default();
-        let mut local_edge_of: FxHashMap<u32, u32> = FxHashMap::default();
+        scratch.fit(mesh, topology);
+        let DomainScratch {
+            vertex: local_vertex_of,
+            edge: local_edge_of,
+            face: local_face_of,
+        } = scratch;
         let mut vertices = Vec::new();
         let mut edges = Vec::new();
-        let local = |map: &mut FxHashMap<u32, u32>, list: &mut Vec<u32>, global: u32| {
-            *map.entry(global).or_insert_with(|| {
+        // Slot 0 means "not yet local"; a local index is stored plus one.
+        let local = |slots: &mut [u32], list: &mut Vec<u32>, global: u32| {
+            let slot = &mut slots[global as usize];
+            if *slot == 0 {
                 list.push(global);
-                list.len() as u32 - 1
-            })
+                *slot = list.len() as u32;
+            }
+            *slot - 1
         };
+        for (i, &f) in faces.iter().enumerate() {
+            local_face_of[f as usize] = i as u32 + 1;
+        }
         let local_faces: Vec<[u32; 3]> = faces
             .iter()
-            .map(|&f| {
-                mesh.triangles[f as usize].map(|v| local(&mut local_vertex_of, &mut vertices, v))
-            })
+            .map(|&f| mesh.triangles[f as usize].map(|v| local(local_vertex_of, &mut vertices, v)))
             .collect();
         let local_face_edges: Vec<[u32; 3]> = faces
             .iter()
-            .map(|&f| {
-                topology.face_edges[f as usize].map(|e| local(&mut local_edge_of, &mut edges, e))
-            })
+            .map(|&f| topology.face_edges[f as usize].map(|e| local(local_edge_of, &mut edges, e)))
             .collect();
         let edge_ends = edges
             .iter()
-            .map(|&e| topology.edges[e as usize].map(|v| local_vertex_of[&v]))
+            .map(|&e| topology.edges[e as usize].map(|v| local_vertex_of[v as usize] - 1))
             .collect();
+        let in_domain = |f: u32| local_face_of[f as usize].checked_sub(1);
         let edge_faces = edges
             .iter()
             .map(|&e| match topology.faces_of_edge(e as usize) {
-                &[f, g] => Some([*local_face_of.get(&f)?, *local_face_of.get(&g)?]),
+                &[f, g] => Some([in_domain(f)?, in_domain(g)?]),
                 _ => None,
             })
             .collect();
+        for &v in &vertices {
+            local_vertex_of[v as usize] = 0;
+        }
+        for &e in &edges {
+            local_edge_of[e as usize] = 0;
+        }
+        for &f in &faces {
+            local_face_of[f as usize] = 0;
+        }
         Self {
             faces,
             local_faces,
@@ -430,7 +468,13 @@ mod tests {
         let mesh = icosphere(1.0, 4);
         let topology = Topology::new(&mesh);
         let snap = vertex_snap_distances(&mesh, &topology, 0.01);
-        let mut domain = SectionDomain::new(&mesh, &topology, &snap, all_faces(&mesh));
+        let mut domain = SectionDomain::new(
+            &mesh,
+            &topology,
+            &snap,
+            all_faces(&mesh),
+            &mut DomainScratch::default(),
+        );
         let plane = Plane {
             point: DVec3::new(0.0, 0.0, 0.3),
             normal: DVec3::Z,
@@ -458,7 +502,13 @@ mod tests {
         let mesh = uv_sphere(1.0, 8, 16);
         let topology = Topology::new(&mesh);
         let snap = vertex_snap_distances(&mesh, &topology, 0.01);
-        let mut domain = SectionDomain::new(&mesh, &topology, &snap, all_faces(&mesh));
+        let mut domain = SectionDomain::new(
+            &mesh,
+            &topology,
+            &snap,
+            all_faces(&mesh),
+            &mut DomainScratch::default(),
+        );
         let plane = Plane {
             point: DVec3::ZERO,
             normal: DVec3::Z,
@@ -486,7 +536,13 @@ mod tests {
             .into_iter()
             .filter(|&f| mesh.corners(f as usize).iter().all(|c| c.y > -0.2))
             .collect();
-        let mut domain = SectionDomain::new(&mesh, &topology, &snap, upper);
+        let mut domain = SectionDomain::new(
+            &mesh,
+            &topology,
+            &snap,
+            upper,
+            &mut DomainScratch::default(),
+        );
         let plane = Plane {
             point: DVec3::ZERO,
             normal: DVec3::Z,
