@@ -33,23 +33,24 @@ impl Topology {
     /// larger vertex, which gives the order (a, b, f, i) of edges and of their faces.
     pub fn new(mesh: &SurfaceMesh) -> Self {
         let nv = mesh.vertex_count();
-        let half = Rows::group(
+        let triangles = &mesh.triangles;
+        let corner = |k: usize| triangles[k / 3][k % 3];
+        let next_corner = |k: usize| triangles[k / 3][(k + 1) % 3];
+        let mut half = Rows::group_indexed(
             nv,
-            mesh.triangles.iter().enumerate().flat_map(|(f, t)| {
-                (0..3).map(move |i| {
-                    let (a, b) = (t[i], t[(i + 1) % 3]);
-                    (a.min(b) as usize, (a.max(b), f as u32, i as u8))
-                })
-            }),
+            3 * triangles.len(),
+            |k| Some(corner(k).min(next_corner(k)) as usize),
+            |k| {
+                let (a, b) = (corner(k), next_corner(k));
+                (a.max(b), (k / 3) as u32, (k % 3) as u8)
+            },
         );
         let mut edges = Vec::new();
         let mut face_edges = vec![[0u32; 3]; mesh.triangles.len()];
         let mut edge_face_offsets = vec![0u32];
         let mut edge_faces = Vec::with_capacity(half.values.len());
-        let mut group = Vec::new();
         for a in 0..nv {
-            group.clear();
-            group.extend_from_slice(half.row(a));
+            let group = &mut half.values[half.offsets[a] as usize..half.offsets[a + 1] as usize];
             group.sort_by_key(|&(b, _, _)| b);
             for (k, &(b, f, i)) in group.iter().enumerate() {
                 if k == 0 || group[k - 1].0 != b {
@@ -68,19 +69,21 @@ impl Topology {
 
         // Both row sets come sorted: a vertex's faces in stored order, its neighbours x < v
         // (edges (x, v)) before those y > v (edges (v, y)), each in edge order.
-        let vertex_faces = Rows::group(
+        let vertex_faces = Rows::group_indexed(
             nv,
-            mesh.triangles
-                .iter()
-                .enumerate()
-                .flat_map(|(f, t)| t.iter().map(move |&v| (v as usize, f as u32))),
+            3 * triangles.len(),
+            |k| Some(corner(k) as usize),
+            |k| (k / 3) as u32,
         );
-        let vertex_neighbors = Rows::group(
+        // Entry 2e is edge e seen from its first end, 2e + 1 from its second.
+        let vertex_neighbors = Rows::group_indexed(
             nv,
-            edges
-                .iter()
-                .filter(|e| e[0] != e[1])
-                .flat_map(|e| [(e[0] as usize, e[1]), (e[1] as usize, e[0])]),
+            2 * edges.len(),
+            |k| {
+                let e = edges[k / 2];
+                (e[0] != e[1]).then_some(e[k % 2] as usize)
+            },
+            |k| edges[k / 2][1 - k % 2],
         );
         Self {
             edges,
