@@ -426,19 +426,22 @@ pub fn closed_length(points: &[DVec3]) -> f64 {
 }
 
 /// Whether `p` lies inside the closed polygon `points` of the plane with unit `normal`
-/// (even–odd crossing rule in plane coordinates).
+/// (even–odd crossing rule in plane coordinates; each edge's test is independent of the
+/// others, so the plane coordinates are computed as the edges are walked, without a copy).
 pub fn polygon_contains(points: &[DVec3], normal: DVec3, p: DVec3) -> bool {
+    let Some(&last) = points.last() else {
+        return false;
+    };
     let (u, w) = normal.any_orthonormal_pair();
-    let planar: Vec<(f64, f64)> = points
-        .iter()
-        .map(|q| ((*q - p).dot(u), (*q - p).dot(w)))
-        .collect();
+    let planar = |q: DVec3| ((q - p).dot(u), (q - p).dot(w));
     let mut inside = false;
-    for (i, &(x0, y0)) in planar.iter().enumerate() {
-        let (x1, y1) = planar[(i + 1) % planar.len()];
+    let (mut x0, mut y0) = planar(last);
+    for &q in points {
+        let (x1, y1) = planar(q);
         if (y0 > 0.0) != (y1 > 0.0) && x0 + (x1 - x0) * (-y0) / (y1 - y0) > 0.0 {
             inside = !inside;
         }
+        (x0, y0) = (x1, y1);
     }
     inside
 }
@@ -553,6 +556,46 @@ mod tests {
             normal: DVec3::Y,
         };
         assert_eq!(domain.closed_sections(&horizontal).len(), 1);
+    }
+
+    /// The reference: the polygon copied into plane coordinates, then the even–odd rule.
+    fn reference_contains(points: &[DVec3], normal: DVec3, p: DVec3) -> bool {
+        let (u, w) = normal.any_orthonormal_pair();
+        let planar: Vec<(f64, f64)> = points
+            .iter()
+            .map(|q| ((*q - p).dot(u), (*q - p).dot(w)))
+            .collect();
+        let mut inside = false;
+        for (i, &(x0, y0)) in planar.iter().enumerate() {
+            let (x1, y1) = planar[(i + 1) % planar.len()];
+            if (y0 > 0.0) != (y1 > 0.0) && x0 + (x1 - x0) * (-y0) / (y1 - y0) > 0.0 {
+                inside = !inside;
+            }
+        }
+        inside
+    }
+
+    /// Random star-shaped and self-crossing polygons, points inside, outside and on
+    /// vertices: the same answers as the reference.
+    #[test]
+    fn containment_without_a_copy_answers_as_the_reference() {
+        let mut rng = atlas_skin_runtime::random_pose::SplitMix64::new(11);
+        let mut next = || rng.next_f64() * 2.0 - 1.0;
+        for n in [0, 1, 3, 7, 20] {
+            let normal = DVec3::new(next(), next(), next()).normalize();
+            let (u, w) = normal.any_orthonormal_pair();
+            let points: Vec<DVec3> = (0..n)
+                .map(|_| u * next() + w * next() + normal * 0.01 * next())
+                .collect();
+            let mut queries: Vec<DVec3> = (0..200).map(|_| u * next() + w * next()).collect();
+            queries.extend(&points);
+            for p in queries {
+                assert_eq!(
+                    polygon_contains(&points, normal, p),
+                    reference_contains(&points, normal, p)
+                );
+            }
+        }
     }
 
     #[test]
