@@ -1,7 +1,9 @@
-//! The nearest of a fixed set of points (the joints) to a query point, exactly: a uniform
-//! grid of a few points per cell, searched in growing shells of cells until the best
-//! distance found cannot be beaten by a farther shell.
+//! The nearest of a fixed set of points (the joints) or of segments (the bones) to a query
+//! point, exactly: a uniform grid of a few points (segment midpoints) per cell, searched in
+//! growing shells of cells until the best distance found cannot be beaten by a farther
+//! shell.
 
+use crate::geometry::point_segment_distance;
 use crate::mesh::spatial_index::CentreGrid;
 use glam::{DVec3, IVec3};
 
@@ -22,41 +24,82 @@ impl PointGrid {
     }
 
     /// The smallest `q.distance(p)` over the points (infinity when there are none): the
-    /// same value as a scan of every point. Shell r holds the cells at Chebyshev distance r
-    /// from p's (clamped) cell; a point in shell r lies at least (r − 1) cells from p (r
-    /// cells along an axis where p lies outside the grid), and at least as far as p lies
-    /// outside the grid: the search stops once that bound passes the best.
+    /// same value as a scan of every point.
     pub fn nearest_distance(&self, p: DVec3) -> f64 {
         let mut best = f64::INFINITY;
-        if self.points.is_empty() {
-            return best;
-        }
-        let grid = &self.grid;
-        let centre = grid.cell_of(p);
-        let outside = (grid.origin - p)
-            .max(p - (grid.origin + grid.dims.as_dvec3() * grid.cell))
-            .max(DVec3::ZERO)
-            .length();
-        for r in 0..=grid.dims.max_element() {
-            let bound = outside.max((r - 1).max(0) as f64 * grid.cell);
-            if bound > best {
-                break;
-            }
-            let (inner_lo, inner_hi) = if r == 0 {
-                (IVec3::ONE, IVec3::ZERO)
-            } else {
-                (centre - IVec3::splat(r - 1), centre + IVec3::splat(r - 1))
-            };
-            for k in grid.faces_in(
-                centre - IVec3::splat(r),
-                centre + IVec3::splat(r),
-                inner_lo,
-                inner_hi,
-            ) {
-                best = best.min(self.points[k as usize].distance(p));
-            }
-        }
+        shells(&self.grid, p, 0.0, &mut |k| {
+            best = best.min(self.points[k as usize].distance(p));
+            best
+        });
         best
+    }
+}
+
+/// Segments [a, b] in the cells of a [`CentreGrid`] of their midpoints.
+#[derive(Debug, Clone)]
+pub struct SegmentGrid {
+    segments: Vec<[DVec3; 2]>,
+    grid: CentreGrid,
+    /// The largest half length: no point of a segment is farther from its midpoint.
+    reach: f64,
+}
+
+impl SegmentGrid {
+    pub fn new(segments: &[[DVec3; 2]]) -> Self {
+        let middles: Vec<DVec3> = segments.iter().map(|&[a, b]| a.midpoint(b)).collect();
+        Self {
+            segments: segments.to_vec(),
+            grid: CentreGrid::new(&middles),
+            reach: segments
+                .iter()
+                .map(|&[a, b]| 0.5 * a.distance(b))
+                .fold(0.0, f64::max),
+        }
+    }
+
+    /// The smallest [`point_segment_distance`] from `p` to the segments (infinity when there
+    /// are none): the same value as a scan of every segment.
+    pub fn nearest_distance(&self, p: DVec3) -> f64 {
+        let mut best = f64::INFINITY;
+        shells(&self.grid, p, self.reach, &mut |k| {
+            let [a, b] = self.segments[k as usize];
+            best = best.min(point_segment_distance(p, a, b));
+            best
+        });
+        best
+    }
+}
+
+/// Visits the items of `grid` in shells of cells around `p` until none can be nearer than
+/// the best so far, which `visit(item)` returns. Shell r holds the cells at Chebyshev
+/// distance r from p's (clamped) cell; an item in shell r has its grid point at least
+/// (r − 1) cells from p (r cells along an axis where p lies outside the grid) and at least
+/// as far as p lies outside the grid, hence lies itself at least that minus `reach` away.
+fn shells(grid: &CentreGrid, p: DVec3, reach: f64, visit: &mut impl FnMut(u32) -> f64) {
+    let mut best = f64::INFINITY;
+    let centre = grid.cell_of(p);
+    let outside = (grid.origin - p)
+        .max(p - (grid.origin + grid.dims.as_dvec3() * grid.cell))
+        .max(DVec3::ZERO)
+        .length();
+    for r in 0..=grid.dims.max_element() {
+        let bound = outside.max((r - 1).max(0) as f64 * grid.cell) - reach;
+        if bound > best {
+            break;
+        }
+        let (inner_lo, inner_hi) = if r == 0 {
+            (IVec3::ONE, IVec3::ZERO)
+        } else {
+            (centre - IVec3::splat(r - 1), centre + IVec3::splat(r - 1))
+        };
+        for k in grid.faces_in(
+            centre - IVec3::splat(r),
+            centre + IVec3::splat(r),
+            inner_lo,
+            inner_hi,
+        ) {
+            best = visit(k);
+        }
     }
 }
 
@@ -95,6 +138,32 @@ mod tests {
                 let scanned = points
                     .iter()
                     .map(|q| q.distance(p))
+                    .fold(f64::INFINITY, f64::min);
+                assert_eq!(grid.nearest_distance(p), scanned);
+            }
+        }
+    }
+
+    /// Short, long, crossing and point segments, queried inside and far outside their box:
+    /// the same distance as a scan of every segment.
+    #[test]
+    fn grid_gives_the_scanned_nearest_segment_distance() {
+        let mut rng = SplitMix64::new(4);
+        let mut random =
+            |scale: f64| DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64()) * scale;
+        for (count, length) in [(0, 0.1), (1, 0.0), (50, 0.05), (300, 0.3), (40, 3.0)] {
+            let segments: Vec<[DVec3; 2]> = (0..count)
+                .map(|_| {
+                    let a = random(2.0);
+                    [a, a + (random(2.0) - DVec3::ONE) * length]
+                })
+                .collect();
+            let grid = SegmentGrid::new(&segments);
+            for _ in 0..300 {
+                let p = random(8.0) - DVec3::splat(2.0);
+                let scanned = segments
+                    .iter()
+                    .map(|&[a, b]| point_segment_distance(p, a, b))
                     .fold(f64::INFINITY, f64::min);
                 assert_eq!(grid.nearest_distance(p), scanned);
             }
