@@ -27,7 +27,7 @@ impl PointGrid {
     /// same value as a scan of every point.
     pub fn nearest_distance(&self, p: DVec3) -> f64 {
         let mut best = f64::INFINITY;
-        shells(&self.grid, p, 0.0, &mut |k| {
+        shells(&self.grid, p, 0.0, f64::INFINITY, &mut |k| {
             best = best.min(self.points[k as usize].distance(p));
             best
         });
@@ -61,22 +61,37 @@ impl SegmentGrid {
     /// are none): the same value as a scan of every segment.
     pub fn nearest_distance(&self, p: DVec3) -> f64 {
         let mut best = f64::INFINITY;
-        shells(&self.grid, p, self.reach, &mut |k| {
+        shells(&self.grid, p, self.reach, f64::INFINITY, &mut |k| {
             let [a, b] = self.segments[k as usize];
             best = best.min(point_segment_distance(p, a, b));
             best
         });
         best
     }
+
+    /// Indices, increasing, of the segments within `radius` of `p`
+    /// ([`point_segment_distance`] ≤ `radius`): the same as a scan of every segment.
+    pub fn within(&self, p: DVec3, radius: f64) -> Vec<u32> {
+        let mut found = Vec::new();
+        shells(&self.grid, p, self.reach, radius, &mut |k| {
+            let [a, b] = self.segments[k as usize];
+            if point_segment_distance(p, a, b) <= radius {
+                found.push(k);
+            }
+            radius
+        });
+        found.sort_unstable();
+        found
+    }
 }
 
 /// Visits the items of `grid` in shells of cells around `p` until none can be nearer than
-/// the best so far, which `visit(item)` returns. Shell r holds the cells at Chebyshev
+/// the distance `visit(item)` returns (the best so far), nor than `limit`. Shell r holds the cells at Chebyshev
 /// distance r from p's (clamped) cell; an item in shell r has its grid point at least
 /// (r − 1) cells from p (r cells along an axis where p lies outside the grid) and at least
 /// as far as p lies outside the grid, hence lies itself at least that minus `reach` away.
-fn shells(grid: &CentreGrid, p: DVec3, reach: f64, visit: &mut impl FnMut(u32) -> f64) {
-    let mut best = f64::INFINITY;
+fn shells(grid: &CentreGrid, p: DVec3, reach: f64, limit: f64, visit: &mut impl FnMut(u32) -> f64) {
+    let mut best = limit;
     let centre = grid.cell_of(p);
     let outside = (grid.origin - p)
         .max(p - (grid.origin + grid.dims.as_dvec3() * grid.cell))
@@ -166,6 +181,14 @@ mod tests {
                     .map(|&[a, b]| point_segment_distance(p, a, b))
                     .fold(f64::INFINITY, f64::min);
                 assert_eq!(grid.nearest_distance(p), scanned);
+                let radius = 0.5;
+                let near: Vec<u32> = (0..segments.len() as u32)
+                    .filter(|&k| {
+                        let [a, b] = segments[k as usize];
+                        point_segment_distance(p, a, b) <= radius
+                    })
+                    .collect();
+                assert_eq!(grid.within(p, radius), near);
             }
         }
     }
