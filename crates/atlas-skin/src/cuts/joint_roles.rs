@@ -424,7 +424,7 @@ fn diagonal(points: &[DVec3]) -> f64 {
 ///
 /// Candidates: normals ±x, ±y, ±z and p_i − p_j for sibling joints i, j whose bones have
 /// equal length (within 5%), sibling groups in order until there are more than
-/// [`SYMMETRY_CANDIDATES`] (a group of many equal siblings is cut there); offset c = median
+/// `SYMMETRY_CANDIDATES` (a group of many equal siblings is cut there); offset c = median
 /// of n · p over the joints. Nearest joints from a grid ([`PointGrid`]): about
 /// O(J log J · candidates).
 pub fn infer_symmetry_plane(

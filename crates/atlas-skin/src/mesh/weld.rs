@@ -34,7 +34,7 @@ pub struct Welded {
 /// Welds `positions` (#V stored) referenced by `triangles` (#F).
 ///
 /// Each welded vertex takes the position of its first stored vertex. Complexity: expected
-/// O(V) with a hash grid ([`close_pairs`]).
+/// O(V) with a hash grid (`close_pairs`).
 pub fn weld(positions: &[Vec3], triangles: &[[u32; 3]], relative_tolerance: f64) -> Welded {
     let stored: Vec<DVec3> = positions.iter().map(|p| p.as_dvec3()).collect();
     let mut referenced = vec![false; stored.len()];

@@ -7,7 +7,7 @@ use crate::geometry::point_segment_distance;
 use crate::mesh::spatial_index::CentreGrid;
 use glam::{DVec3, IVec3};
 
-/// The points in the cells of a [`CentreGrid`].
+/// The points in the cells of a grid (`mesh::spatial_index::CentreGrid`).
 #[derive(Debug, Clone)]
 pub struct PointGrid {
     points: Vec<DVec3>,
@@ -35,7 +35,7 @@ impl PointGrid {
     }
 }
 
-/// Segments [a, b] in the cells of a [`CentreGrid`] of their midpoints.
+/// Segments [a, b] in the cells of a grid of their midpoints.
 #[derive(Debug, Clone)]
 pub struct SegmentGrid {
     segments: Vec<[DVec3; 2]>,
