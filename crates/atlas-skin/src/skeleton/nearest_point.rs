@@ -7,6 +7,9 @@ use crate::geometry::point_segment_distance;
 use crate::mesh::spatial_index::CentreGrid;
 use glam::{DVec3, IVec3};
 
+/// Below this many points or segments a scan is cheaper than the grid's shells.
+const SCAN_BELOW: usize = 64;
+
 /// The points in the cells of a grid (`mesh::spatial_index::CentreGrid`).
 #[derive(Debug, Clone)]
 pub struct PointGrid {
@@ -26,9 +29,15 @@ impl PointGrid {
     /// The smallest `q.distance(p)` over the points (infinity when there are none): the
     /// same value as a scan of every point.
     pub fn nearest_distance(&self, p: DVec3) -> f64 {
+        let distance = |k: u32| self.points[k as usize].distance(p);
         let mut best = f64::INFINITY;
+        if self.points.len() < SCAN_BELOW {
+            return (0..self.points.len() as u32)
+                .map(distance)
+                .fold(best, f64::min);
+        }
         shells(&self.grid, p, 0.0, f64::INFINITY, &mut |k| {
-            best = best.min(self.points[k as usize].distance(p));
+            best = best.min(distance(k));
             best
         });
         best
@@ -60,10 +69,18 @@ impl SegmentGrid {
     /// The smallest [`point_segment_distance`] from `p` to the segments (infinity when there
     /// are none): the same value as a scan of every segment.
     pub fn nearest_distance(&self, p: DVec3) -> f64 {
-        let mut best = f64::INFINITY;
-        shells(&self.grid, p, self.reach, f64::INFINITY, &mut |k| {
+        let distance = |k: u32| {
             let [a, b] = self.segments[k as usize];
-            best = best.min(point_segment_distance(p, a, b));
+            point_segment_distance(p, a, b)
+        };
+        let mut best = f64::INFINITY;
+        if self.segments.len() < SCAN_BELOW {
+            return (0..self.segments.len() as u32)
+                .map(distance)
+                .fold(best, f64::min);
+        }
+        shells(&self.grid, p, self.reach, f64::INFINITY, &mut |k| {
+            best = best.min(distance(k));
             best
         });
         best
@@ -72,10 +89,18 @@ impl SegmentGrid {
     /// Indices, increasing, of the segments within `radius` of `p`
     /// ([`point_segment_distance`] ≤ `radius`): the same as a scan of every segment.
     pub fn within(&self, p: DVec3, radius: f64) -> Vec<u32> {
+        let near = |k: u32| {
+            let [a, b] = self.segments[k as usize];
+            point_segment_distance(p, a, b) <= radius
+        };
+        if self.segments.len() < SCAN_BELOW {
+            return (0..self.segments.len() as u32)
+                .filter(|&k| near(k))
+                .collect();
+        }
         let mut found = Vec::new();
         shells(&self.grid, p, self.reach, radius, &mut |k| {
-            let [a, b] = self.segments[k as usize];
-            if point_segment_distance(p, a, b) <= radius {
+            if near(k) {
                 found.push(k);
             }
             radius
