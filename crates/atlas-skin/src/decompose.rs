@@ -13,13 +13,15 @@
 
 use crate::cuts::conflicts::{place_cuts, Placement};
 use crate::cuts::joint_roles::{plan_joints, JointFrame, JointPlan};
-use crate::cuts::plane_search::{find_cut_candidates, CutCandidate, CutSearch, CutSurface};
-use crate::cuts::plane_section::{diameter, vertex_snap_distances};
+use crate::cuts::plane_search::{
+    find_cut_candidates, BoneIndex, CutCandidate, CutSearch, CutSurface,
+};
+use crate::cuts::plane_section::{diameter, vertex_snap_distances, DomainScratch};
 use crate::cuts::split::split_along_curves;
 use crate::decomposition::{Boundary, BoundaryKind, Decomposition, JointDecision, JointStatus};
 use crate::mesh::{FaceSpheres, SurfaceMesh, Topology};
 use crate::regions::{bind_parent_sides, bind_regions, grow_regions, side_regions};
-use crate::skeleton::bones::{bones_not_at, joint_pairs};
+use crate::skeleton::bones::joint_pairs;
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -264,13 +266,13 @@ fn search_all_cuts(
     positions: &[DVec3],
     plans: &[JointPlan],
 ) -> Vec<CutSearch> {
-    let bones = joint_pairs(skeleton, positions);
+    let bones = BoneIndex::new(joint_pairs(skeleton, positions), positions);
     plans
         .par_iter()
         .enumerate()
-        .map(|(j, plan)| match plan {
+        .map_init(DomainScratch::default, |scratch, (j, plan)| match plan {
             JointPlan::Boundary(frame) | JointPlan::Soft(frame, _) => {
-                find_cut_candidates(surface, frame, &bones_not_at(&bones, positions, j))
+                find_cut_candidates(surface, j, frame, &bones, scratch)
             }
             JointPlan::Skip(_) | JointPlan::Exclude(_) => CutSearch::default(),
         })

@@ -87,12 +87,13 @@ fn closest_point_on_edges(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> [f64; 3] {
 }
 
 /// Axis-aligned bounding box of points, `(0, 0)` when there are none.
-pub fn bounding_box(points: &[DVec3]) -> (DVec3, DVec3) {
-    if points.is_empty() {
-        return (DVec3::ZERO, DVec3::ZERO);
-    }
-    points.iter().fold(
+pub fn bounding_box<'a>(points: impl IntoIterator<Item = &'a DVec3>) -> (DVec3, DVec3) {
+    let (lo, hi) = points.into_iter().fold(
         (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
         |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-    )
+    );
+    if lo.x > hi.x {
+        return (DVec3::ZERO, DVec3::ZERO);
+    }
+    (lo, hi)
 }

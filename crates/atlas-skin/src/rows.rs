@@ -54,6 +54,37 @@ impl<T: Copy + Default> Rows<T> {
     }
 }
 
+impl<T: Copy + Default> Rows<T> {
+    /// [`Rows::group`] of the entries `k` in `0..count` whose `key(k)` is some row index
+    /// (`< n`), with value `value(k)`: the same rows, from plain index loops (no iterator
+    /// to clone and walk twice), for the large groupings of the topology.
+    pub fn group_indexed(
+        n: usize,
+        count: usize,
+        key: impl Fn(usize) -> Option<usize>,
+        value: impl Fn(usize) -> T,
+    ) -> Self {
+        let mut offsets = vec![0u32; n + 1];
+        for k in 0..count {
+            if let Some(i) = key(k) {
+                offsets[i + 1] += 1;
+            }
+        }
+        for i in 0..n {
+            offsets[i + 1] += offsets[i];
+        }
+        let mut next = offsets[..n].to_vec();
+        let mut values = vec![T::default(); offsets[n] as usize];
+        for k in 0..count {
+            if let Some(i) = key(k) {
+                values[next[i] as usize] = value(k);
+                next[i] += 1;
+            }
+        }
+        Self { offsets, values }
+    }
+}
+
 impl<T: Send> Rows<T> {
     /// Builds `n` rows in parallel, in chunks of `chunk` rows: `fill(i, scratch, out)`
     /// appends row i's values to `out`; `scratch` is working memory reused within a chunk.
@@ -102,6 +133,14 @@ mod tests {
             (rows.row(0), rows.row(1), rows.row(2)),
             (&['b'][..], &[][..], &['a', 'c'][..])
         );
+    }
+
+    #[test]
+    fn indexed_grouping_equals_grouping() {
+        let key = |k: usize| (k % 7 != 3).then_some((k * 5) % 11);
+        let indexed = Rows::group_indexed(11, 100, key, |k| k as u32);
+        let entries = (0..100).filter_map(|k| key(k).map(|i| (i, k as u32)));
+        assert_eq!(indexed, Rows::group(11, entries));
     }
 
     #[test]

@@ -49,6 +49,7 @@ use crate::geometry::point_segment_distance;
 use crate::mesh::spatial_index::FaceSpheres;
 use crate::mesh::SurfaceMesh;
 use crate::skeleton::bones::{bones_not_at, joint_pairs};
+use crate::skeleton::nearest_point::PointGrid;
 use crate::tolerance::NEGLIGIBLE;
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
@@ -410,7 +411,10 @@ fn diagonal(points: &[DVec3]) -> f64 {
 /// least one pair of joints onto each other.
 ///
 /// Candidates: normals ±x, ±y, ±z and p_i − p_j for sibling joints i, j whose bones have
-/// equal length (within 5%); offset c = median of n · p over the joints. O(J² · candidates).
+/// equal length (within 5%), sibling groups in order until there are more than
+/// `SYMMETRY_CANDIDATES` (a group of many equal siblings is cut there); offset c = median
+/// of n · p over the joints. Nearest joints from a grid ([`PointGrid`]): about
+/// O(J log J · candidates).
 pub fn infer_symmetry_plane(
     skeleton: &Skeleton,
     positions: &[DVec3],
@@ -421,7 +425,7 @@ pub fn infer_symmetry_plane(
         return None;
     }
     let mut normals = vec![DVec3::X, DVec3::Y, DVec3::Z];
-    for siblings in skeleton.children() {
+    'groups: for siblings in skeleton.children() {
         for (k, &a) in siblings.iter().enumerate() {
             for &b in &siblings[k + 1..] {
                 let Some(p) = skeleton.parent(a) else {
@@ -436,12 +440,16 @@ pub fn infer_symmetry_plane(
                         normals.push(n);
                     }
                 }
+                if normals.len() > SYMMETRY_CANDIDATES_IN_GROUP {
+                    break 'groups;
+                }
             }
         }
-        if normals.len() > 24 {
+        if normals.len() > SYMMETRY_CANDIDATES {
             break;
         }
     }
+    let joints = PointGrid::new(positions);
     normals
         .into_iter()
         .filter_map(|normal| {
@@ -453,10 +461,7 @@ pub fn infer_symmetry_plane(
             for p in positions {
                 let height = normal.dot(*p) - offset;
                 let mirrored = *p - 2.0 * height * normal;
-                total += positions
-                    .iter()
-                    .map(|q| q.distance(mirrored))
-                    .fold(f64::INFINITY, f64::min);
+                total += joints.nearest_distance(mirrored);
                 if height.abs() > tolerance * scale {
                     paired += 1;
                 }
@@ -470,6 +475,14 @@ pub fn infer_symmetry_plane(
         })
         .min_by(|a, b| a.mismatch.total_cmp(&b.mismatch))
 }
+
+/// Candidate normals of [`infer_symmetry_plane`]: sibling groups are read until there are
+/// more than this many.
+const SYMMETRY_CANDIDATES: usize = 24;
+
+/// And within one group, candidates stop past this many (a hand's fingers give 10 pairs;
+/// 10,000 sibling joints would give 50 million).
+const SYMMETRY_CANDIDATES_IN_GROUP: usize = 100;
 
 #[cfg(test)]
 mod tests {

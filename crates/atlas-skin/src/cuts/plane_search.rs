@@ -21,11 +21,11 @@
 use super::params::DecomposeParams;
 use crate::cuts::joint_roles::JointFrame;
 use crate::cuts::plane_section::{
-    closed_length, polygon_contains, Plane, SectionCurve, SectionDomain,
+    closed_length, polygon_contains, DomainScratch, Plane, SectionCurve, SectionDomain,
 };
-use crate::geometry::point_segment_distance;
 use crate::mesh::spatial_index::FaceSpheres;
 use crate::mesh::{SurfaceMesh, Topology};
+use crate::skeleton::nearest_point::SegmentGrid;
 use glam::DVec3;
 
 /// How many times the neighbourhood doubles when it holds no closed section around the
@@ -68,12 +68,54 @@ pub struct CutSearch {
     pub enclosing_other_bones: usize,
 }
 
-/// Every closed section around the joint of `frame` that no bone of `other_bones` passes
-/// through, found by the search; none when no sampled plane gives one.
+/// The bones of the skeleton as segments, with a grid for the bones near a point.
+#[derive(Debug, Clone)]
+pub struct BoneIndex {
+    /// (parent, child) joints of every bone ([`crate::skeleton::bones::joint_pairs`]).
+    pairs: Vec<(usize, usize)>,
+    segments: Vec<[DVec3; 2]>,
+    grid: SegmentGrid,
+}
+
+impl BoneIndex {
+    /// - `positions`: #J bind positions of the joints of `pairs`.
+    pub fn new(pairs: Vec<(usize, usize)>, positions: &[DVec3]) -> Self {
+        let segments: Vec<[DVec3; 2]> = pairs
+            .iter()
+            .map(|&(p, c)| [positions[p], positions[c]])
+            .collect();
+        let grid = SegmentGrid::new(&segments);
+        Self {
+            pairs,
+            segments,
+            grid,
+        }
+    }
+
+    /// The bones with neither end at `joint` within `radius` of `point`, in bone order.
+    fn near(&self, joint: usize, point: DVec3, radius: f64) -> Vec<[DVec3; 2]> {
+        self.grid
+            .within(point, radius)
+            .into_iter()
+            .filter(|&k| {
+                let (p, c) = self.pairs[k as usize];
+                p != joint && c != joint
+            })
+            .map(|k| self.segments[k as usize])
+            .collect()
+    }
+}
+
+/// Every closed section around joint `joint` (its `frame`) that no other bone of `bones`
+/// (one with neither end at the joint) passes through, found by the search; none when no
+/// sampled plane gives one. `scratch`: working memory of the section domains, reused from
+/// joint to joint.
 pub fn find_cut_candidates(
     surface: &CutSurface,
+    joint: usize,
     frame: &JointFrame,
-    other_bones: &[[DVec3; 2]],
+    bones: &BoneIndex,
+    scratch: &mut DomainScratch,
 ) -> CutSearch {
     let mut radius =
         surface.params.neighbourhood_factor * frame.surface_distance.max(0.1 * frame.bone_length);
@@ -81,12 +123,8 @@ pub fn find_cut_candidates(
     for _ in 0..NEIGHBOURHOOD_ATTEMPTS {
         let faces = surface.spheres.faces_near(frame.position, radius);
         let everything = faces.len() == surface.mesh.triangle_count();
-        let near_bones: Vec<[DVec3; 2]> = other_bones
-            .iter()
-            .filter(|[a, b]| point_segment_distance(frame.position, *a, *b) <= 2.0 * radius)
-            .copied()
-            .collect();
-        let search = search_within(surface, frame, &near_bones, faces);
+        let near_bones = bones.near(joint, frame.position, 2.0 * radius);
+        let search = search_within(surface, frame, &near_bones, faces, scratch);
         if !search.candidates.is_empty() || everything {
             return search;
         }
@@ -102,6 +140,7 @@ fn search_within(
     frame: &JointFrame,
     other_bones: &[[DVec3; 2]],
     faces: Vec<u32>,
+    scratch: &mut DomainScratch,
 ) -> CutSearch {
     let (mesh, topology, params) = (surface.mesh, surface.topology, surface.params);
     let mut search = PlaneSearch {
@@ -110,7 +149,7 @@ fn search_within(
         other_bones,
         enclosing_other_bones: 0,
         position: frame.position,
-        domain: SectionDomain::new(mesh, topology, surface.vertex_snap, faces),
+        domain: SectionDomain::new(mesh, topology, surface.vertex_snap, faces, scratch),
         basis: NormalBasis::new(frame.upper, frame.lower),
     };
     let step = params.angle_step_deg.to_radians();
@@ -268,7 +307,7 @@ impl PlaneSearch<'_> {
             normal: self.basis.normal(alpha, beta),
         };
         let mut best: Option<CutCandidate> = None;
-        for curve in self.domain.closed_sections(self.topology, &plane) {
+        for curve in self.domain.closed_sections(&plane) {
             let points = curve.positions(self.mesh, self.topology);
             if !polygon_contains(&points, plane.normal, plane.point) {
                 continue;

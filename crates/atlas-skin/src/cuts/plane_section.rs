@@ -75,26 +75,61 @@ pub struct Chord {
 }
 
 /// The faces a section is computed on (near one joint), with buffers reused by every
-/// query. A query computes the signed distance and side of the domain's vertices only and
-/// scans the domain's faces by local vertex index; only the few crossed faces are traced
-/// through the mesh's topology, with #E visit stamps and #V, #F lookups of the whole mesh
-/// (zeroed allocations, set once per domain).
+/// query. Everything is indexed locally (vertices, edges and faces of the domain), so that
+/// building a domain costs O(its faces), not O(the mesh), and a query touches only the
+/// domain's own arrays: it computes the signed distance and side of the domain's vertices
+/// and scans its faces; only the few crossed faces are traced, through each local edge's
+/// faces across.
 #[derive(Debug, Clone)]
 pub struct SectionDomain {
+    /// Per local face: its face of the mesh, its corners and its edges (in the order of
+    /// [`Topology::face_edges`]) as local indices.
     faces: Vec<u32>,
-    /// The domain's faces as triples of local vertex indices.
     local_faces: Vec<[u32; 3]>,
-    /// Per local vertex: its position, snap distance, signed distance and side (1 when
-    /// d ≥ 0, else 0: a face is crossed when its corners' sides sum to 1 or 2).
+    local_face_edges: Vec<[u32; 3]>,
+    /// Per local vertex: its vertex of the mesh, position, snap distance, signed distance
+    /// and side (1 when d ≥ 0, else 0: a face is crossed when its corners' sides sum to 1
+    /// or 2).
+    vertices: Vec<u32>,
     local_positions: Vec<DVec3>,
     local_snap: Vec<f64>,
     local_distance: Vec<f64>,
     local_side: Vec<u8>,
-    /// Per global vertex: 1 + its local index, 0 outside the domain.
-    local_of: Vec<u32>,
-    in_domain: Vec<bool>,
+    /// Per local edge: its edge of the mesh, its ends (local, in the order of
+    /// [`Topology::edges`]), its two faces (local, in the order of
+    /// [`Topology::faces_of_edge`]) when it is manifold with both in the domain, and the
+    /// stamp of the last query that visited it.
+    edges: Vec<u32>,
+    edge_ends: Vec<[u32; 2]>,
+    edge_faces: Vec<Option<[u32; 2]>>,
     edge_stamp: Vec<u32>,
     stamp: u32,
+}
+
+/// Maps from the mesh's vertices, edges and faces to a domain's (0, or 1 + the local
+/// index) used while building a [`SectionDomain`]: allocated once per thread for the whole
+/// mesh and cleared entry by entry, so that a domain costs O(its faces).
+#[derive(Debug, Clone, Default)]
+pub struct DomainScratch {
+    vertex: Vec<u32>,
+    edge: Vec<u32>,
+    face: Vec<u32>,
+}
+
+impl DomainScratch {
+    /// Grows the maps to the mesh's sizes (all zero; a zeroed allocation, whose pages the
+    /// system provides as they are first touched).
+    fn fit(&mut self, mesh: &SurfaceMesh, topology: &Topology) {
+        for (map, n) in [
+            (&mut self.vertex, mesh.vertex_count()),
+            (&mut self.edge, topology.edges.len()),
+            (&mut self.face, mesh.triangle_count()),
+        ] {
+            if map.len() < n {
+                *map = vec![0; n];
+            }
+        }
+    }
 }
 
 /// Snap distance of every vertex: `fraction` × its longest incident edge (0 for an isolated
@@ -112,12 +147,14 @@ pub fn vertex_snap_distances(mesh: &SurfaceMesh, topology: &Topology, fraction: 
 
 impl SectionDomain {
     /// A domain of `faces` of `mesh`; faces with a repeated vertex index are left out (a
-    /// curve reaching them is open).
+    /// curve reaching them is open). `scratch` maps the mesh's indices to local ones while
+    /// building and is left clean for the next domain.
     pub fn new(
         mesh: &SurfaceMesh,
         topology: &Topology,
         vertex_snap: &[f64],
         faces: Vec<u32>,
+        scratch: &mut DomainScratch,
     ) -> Self {
         let faces: Vec<u32> = faces
             .into_iter()
@@ -126,26 +163,59 @@ impl SectionDomain {
                 a != b && b != c && a != c
             })
             .collect();
-        let mut in_domain = vec![false; mesh.triangle_count()];
-        let mut local_of = vec![0u32; mesh.vertex_count()];
+        scratch.fit(mesh, topology);
+        let DomainScratch {
+            vertex: local_vertex_of,
+            edge: local_edge_of,
+            face: local_face_of,
+        } = scratch;
         let mut vertices = Vec::new();
-        let local_faces = faces
+        let mut edges = Vec::new();
+        // Slot 0 means "not yet local"; a local index is stored plus one.
+        let local = |slots: &mut [u32], list: &mut Vec<u32>, global: u32| {
+            let slot = &mut slots[global as usize];
+            if *slot == 0 {
+                list.push(global);
+                *slot = list.len() as u32;
+            }
+            *slot - 1
+        };
+        for (i, &f) in faces.iter().enumerate() {
+            local_face_of[f as usize] = i as u32 + 1;
+        }
+        let local_faces: Vec<[u32; 3]> = faces
             .iter()
-            .map(|&f| {
-                in_domain[f as usize] = true;
-                mesh.triangles[f as usize].map(|v| {
-                    let slot = &mut local_of[v as usize];
-                    if *slot == 0 {
-                        vertices.push(v);
-                        *slot = vertices.len() as u32;
-                    }
-                    *slot - 1
-                })
+            .map(|&f| mesh.triangles[f as usize].map(|v| local(local_vertex_of, &mut vertices, v)))
+            .collect();
+        let local_face_edges: Vec<[u32; 3]> = faces
+            .iter()
+            .map(|&f| topology.face_edges[f as usize].map(|e| local(local_edge_of, &mut edges, e)))
+            .collect();
+        let edge_ends = edges
+            .iter()
+            .map(|&e| topology.edges[e as usize].map(|v| local_vertex_of[v as usize] - 1))
+            .collect();
+        let in_domain = |f: u32| local_face_of[f as usize].checked_sub(1);
+        let edge_faces = edges
+            .iter()
+            .map(|&e| match topology.faces_of_edge(e as usize) {
+                &[f, g] => Some([in_domain(f)?, in_domain(g)?]),
+                _ => None,
             })
             .collect();
+        for &v in &vertices {
+            local_vertex_of[v as usize] = 0;
+        }
+        for &e in &edges {
+            local_edge_of[e as usize] = 0;
+        }
+        for &f in &faces {
+            local_face_of[f as usize] = 0;
+        }
         Self {
             faces,
             local_faces,
+            local_face_edges,
             local_positions: vertices
                 .iter()
                 .map(|&v| mesh.positions[v as usize])
@@ -153,9 +223,11 @@ impl SectionDomain {
             local_snap: vertices.iter().map(|&v| vertex_snap[v as usize]).collect(),
             local_distance: vec![0.0; vertices.len()],
             local_side: vec![0; vertices.len()],
-            local_of,
-            in_domain,
-            edge_stamp: vec![0; topology.edges.len()],
+            vertices,
+            edge_stamp: vec![0; edges.len()],
+            edges,
+            edge_ends,
+            edge_faces,
             stamp: 0,
         }
     }
@@ -163,7 +235,7 @@ impl SectionDomain {
     /// The closed curves in which `plane` meets the domain's faces. A chain that leaves the
     /// domain (a face outside it, a boundary or non-manifold edge) is open and dropped.
     /// Cost O(faces of the domain).
-    pub fn closed_sections(&mut self, topology: &Topology, plane: &Plane) -> Vec<SectionCurve> {
+    pub fn closed_sections(&mut self, plane: &Plane) -> Vec<SectionCurve> {
         for ((d, side), (p, snap)) in self
             .local_distance
             .iter_mut()
@@ -188,10 +260,9 @@ impl SectionDomain {
             if sides == 0 || sides == 3 {
                 continue;
             }
-            let f = self.faces[i] as usize;
-            for &e in &topology.face_edges[f] {
-                if self.edge_stamp[e as usize] != self.stamp && self.is_crossed(topology, e) {
-                    if let Some(curve) = self.trace(topology, e) {
+            for e in self.local_face_edges[i] {
+                if self.edge_stamp[e as usize] != self.stamp && self.is_crossed(e) {
+                    if let Some(curve) = self.trace(e) {
                         curves.push(curve);
                     }
                 }
@@ -200,62 +271,58 @@ impl SectionDomain {
         curves
     }
 
-    /// Local index of global vertex `v`, a corner of a domain face.
-    fn local(&self, v: u32) -> usize {
-        self.local_of[v as usize] as usize - 1
+    /// Whether local edge `e` has its ends on different sides.
+    fn is_crossed(&self, e: u32) -> bool {
+        let [a, b] = self.edge_ends[e as usize];
+        self.local_side[a as usize] != self.local_side[b as usize]
     }
 
-    fn is_crossed(&self, topology: &Topology, e: u32) -> bool {
-        let [a, b] = topology.edges[e as usize];
-        self.local_side[self.local(a)] != self.local_side[self.local(b)]
-    }
-
-    fn crossing(&self, topology: &Topology, e: u32) -> EdgeCrossing {
-        let [a, b] = topology.edges[e as usize];
+    fn crossing(&self, e: u32) -> EdgeCrossing {
+        let [a, b] = self.edge_ends[e as usize];
         let (da, db) = (
-            self.local_distance[self.local(a)],
-            self.local_distance[self.local(b)],
+            self.local_distance[a as usize],
+            self.local_distance[b as usize],
         );
         let point = if da == 0.0 {
-            CrossingPoint::Vertex(a)
+            CrossingPoint::Vertex(self.vertices[a as usize])
         } else if db == 0.0 {
-            CrossingPoint::Vertex(b)
+            CrossingPoint::Vertex(self.vertices[b as usize])
         } else {
             CrossingPoint::Interior(da / (da - db))
         };
-        EdgeCrossing { edge: e, point }
+        EdgeCrossing {
+            edge: self.edges[e as usize],
+            point,
+        }
     }
 
-    /// The face across edge `e` from `from`, if `e` is manifold and that face is in the domain.
-    fn face_across(&self, topology: &Topology, e: u32, from: Option<u32>) -> Option<u32> {
-        let faces = topology.faces_of_edge(e as usize);
-        if faces.len() != 2 || !faces.iter().all(|&f| self.in_domain[f as usize]) {
-            return None;
-        }
+    /// The local face across local edge `e` from `from`, if `e` is manifold and both its
+    /// faces are in the domain (the first of them when there is no `from`).
+    fn face_across(&self, e: u32, from: Option<u32>) -> Option<u32> {
+        let faces = self.edge_faces[e as usize]?;
         match from {
             Some(g) if faces[0] == g => Some(faces[1]),
-            Some(_) => Some(faces[0]),
-            None => Some(faces[0]),
+            _ => Some(faces[0]),
         }
     }
 
-    /// Follows the chain from crossed edge `start`; `Some` when it closes on `start`.
-    fn trace(&mut self, topology: &Topology, start: u32) -> Option<SectionCurve> {
+    /// Follows the chain from crossed local edge `start`; `Some` when it closes on `start`.
+    fn trace(&mut self, start: u32) -> Option<SectionCurve> {
         self.edge_stamp[start as usize] = self.stamp;
-        let mut crossings = vec![self.crossing(topology, start)];
+        let mut crossings = vec![self.crossing(start)];
         let mut faces = Vec::new();
         let (mut edge, mut from) = (start, None);
         loop {
-            let face = self.face_across(topology, edge, from)?;
-            let mut others = topology.face_edges[face as usize]
+            let face = self.face_across(edge, from)?;
+            let mut others = self.local_face_edges[face as usize]
                 .iter()
                 .copied()
-                .filter(|&g| g != edge && self.is_crossed(topology, g));
+                .filter(|&g| g != edge && self.is_crossed(g));
             let next = others.next()?;
             if others.next().is_some() {
                 return None;
             }
-            faces.push(face);
+            faces.push(self.faces[face as usize]);
             if next == start {
                 return Some(SectionCurve { crossings, faces });
             }
@@ -263,7 +330,7 @@ impl SectionDomain {
                 return None;
             }
             self.edge_stamp[next as usize] = self.stamp;
-            crossings.push(self.crossing(topology, next));
+            crossings.push(self.crossing(next));
             (edge, from) = (next, Some(face));
         }
     }
@@ -359,19 +426,22 @@ pub fn closed_length(points: &[DVec3]) -> f64 {
 }
 
 /// Whether `p` lies inside the closed polygon `points` of the plane with unit `normal`
-/// (even–odd crossing rule in plane coordinates).
+/// (even–odd crossing rule in plane coordinates; each edge's test is independent of the
+/// others, so the plane coordinates are computed as the edges are walked, without a copy).
 pub fn polygon_contains(points: &[DVec3], normal: DVec3, p: DVec3) -> bool {
+    let Some(&last) = points.last() else {
+        return false;
+    };
     let (u, w) = normal.any_orthonormal_pair();
-    let planar: Vec<(f64, f64)> = points
-        .iter()
-        .map(|q| ((*q - p).dot(u), (*q - p).dot(w)))
-        .collect();
+    let planar = |q: DVec3| ((q - p).dot(u), (q - p).dot(w));
     let mut inside = false;
-    for (i, &(x0, y0)) in planar.iter().enumerate() {
-        let (x1, y1) = planar[(i + 1) % planar.len()];
+    let (mut x0, mut y0) = planar(last);
+    for &q in points {
+        let (x1, y1) = planar(q);
         if (y0 > 0.0) != (y1 > 0.0) && x0 + (x1 - x0) * (-y0) / (y1 - y0) > 0.0 {
             inside = !inside;
         }
+        (x0, y0) = (x1, y1);
     }
     inside
 }
@@ -401,12 +471,18 @@ mod tests {
         let mesh = icosphere(1.0, 4);
         let topology = Topology::new(&mesh);
         let snap = vertex_snap_distances(&mesh, &topology, 0.01);
-        let mut domain = SectionDomain::new(&mesh, &topology, &snap, all_faces(&mesh));
+        let mut domain = SectionDomain::new(
+            &mesh,
+            &topology,
+            &snap,
+            all_faces(&mesh),
+            &mut DomainScratch::default(),
+        );
         let plane = Plane {
             point: DVec3::new(0.0, 0.0, 0.3),
             normal: DVec3::Z,
         };
-        let curves = domain.closed_sections(&topology, &plane);
+        let curves = domain.closed_sections(&plane);
         assert_eq!(curves.len(), 1);
         let points = curves[0].positions(&mesh, &topology);
         let radius = (1.0f64 - 0.09).sqrt();
@@ -429,12 +505,18 @@ mod tests {
         let mesh = uv_sphere(1.0, 8, 16);
         let topology = Topology::new(&mesh);
         let snap = vertex_snap_distances(&mesh, &topology, 0.01);
-        let mut domain = SectionDomain::new(&mesh, &topology, &snap, all_faces(&mesh));
+        let mut domain = SectionDomain::new(
+            &mesh,
+            &topology,
+            &snap,
+            all_faces(&mesh),
+            &mut DomainScratch::default(),
+        );
         let plane = Plane {
             point: DVec3::ZERO,
             normal: DVec3::Z,
         };
-        let curves = domain.closed_sections(&topology, &plane);
+        let curves = domain.closed_sections(&plane);
         assert_eq!(curves.len(), 1);
         let mut vertices: Vec<u32> = curves[0]
             .crossings
@@ -457,17 +539,63 @@ mod tests {
             .into_iter()
             .filter(|&f| mesh.corners(f as usize).iter().all(|c| c.y > -0.2))
             .collect();
-        let mut domain = SectionDomain::new(&mesh, &topology, &snap, upper);
+        let mut domain = SectionDomain::new(
+            &mesh,
+            &topology,
+            &snap,
+            upper,
+            &mut DomainScratch::default(),
+        );
         let plane = Plane {
             point: DVec3::ZERO,
             normal: DVec3::Z,
         };
-        assert!(domain.closed_sections(&topology, &plane).is_empty());
+        assert!(domain.closed_sections(&plane).is_empty());
         let horizontal = Plane {
             point: DVec3::Y * 0.5,
             normal: DVec3::Y,
         };
-        assert_eq!(domain.closed_sections(&topology, &horizontal).len(), 1);
+        assert_eq!(domain.closed_sections(&horizontal).len(), 1);
+    }
+
+    /// The reference: the polygon copied into plane coordinates, then the even–odd rule.
+    fn reference_contains(points: &[DVec3], normal: DVec3, p: DVec3) -> bool {
+        let (u, w) = normal.any_orthonormal_pair();
+        let planar: Vec<(f64, f64)> = points
+            .iter()
+            .map(|q| ((*q - p).dot(u), (*q - p).dot(w)))
+            .collect();
+        let mut inside = false;
+        for (i, &(x0, y0)) in planar.iter().enumerate() {
+            let (x1, y1) = planar[(i + 1) % planar.len()];
+            if (y0 > 0.0) != (y1 > 0.0) && x0 + (x1 - x0) * (-y0) / (y1 - y0) > 0.0 {
+                inside = !inside;
+            }
+        }
+        inside
+    }
+
+    /// Random star-shaped and self-crossing polygons, points inside, outside and on
+    /// vertices: the same answers as the reference.
+    #[test]
+    fn containment_without_a_copy_answers_as_the_reference() {
+        let mut rng = atlas_skin_runtime::random_pose::SplitMix64::new(11);
+        let mut next = || rng.next_f64() * 2.0 - 1.0;
+        for n in [0, 1, 3, 7, 20] {
+            let normal = DVec3::new(next(), next(), next()).normalize();
+            let (u, w) = normal.any_orthonormal_pair();
+            let points: Vec<DVec3> = (0..n)
+                .map(|_| u * next() + w * next() + normal * 0.01 * next())
+                .collect();
+            let mut queries: Vec<DVec3> = (0..200).map(|_| u * next() + w * next()).collect();
+            queries.extend(&points);
+            for p in queries {
+                assert_eq!(
+                    polygon_contains(&points, normal, p),
+                    reference_contains(&points, normal, p)
+                );
+            }
+        }
     }
 
     #[test]

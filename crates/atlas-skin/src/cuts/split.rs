@@ -187,7 +187,7 @@ fn fan(piece: &[u32], positions: &mut Vec<glam::DVec3>, triangles: &mut Vec<[u32
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cuts::plane_section::{vertex_snap_distances, Plane, SectionDomain};
+    use crate::cuts::plane_section::{vertex_snap_distances, DomainScratch, Plane, SectionDomain};
     use crate::fixtures::shapes::{icosphere, uv_sphere};
     use crate::mesh::MeshStats;
     use glam::DVec3;
@@ -200,10 +200,11 @@ mod tests {
             &topology,
             &snap,
             (0..mesh.triangle_count() as u32).collect(),
+            &mut DomainScratch::default(),
         );
         let curves: Vec<SectionCurve> = planes
             .iter()
-            .flat_map(|plane| domain.closed_sections(&topology, plane))
+            .flat_map(|plane| domain.closed_sections(plane))
             .collect();
         split_along_curves(mesh, &topology, &curves.iter().collect::<Vec<_>>())
     }

@@ -6,17 +6,43 @@
 //! the doubled demo).
 
 use super::surface::SurfaceMesh;
-use std::collections::HashSet;
+use crate::rows::Rows;
 
 /// Removes every triangle whose vertex set an earlier triangle already has, keeping the
 /// first (stored order) and the order of the rest; returns how many were removed.
+///
+/// The triangles are grouped by their smallest vertex (a counting sort, which keeps the
+/// stored order within a group: [`Rows::group_indexed`]); a triangle is a copy when an
+/// earlier one of its group has the same other two vertices. O(V + F) for groups of
+/// bounded size (a vertex's fan).
 pub fn remove_duplicate_faces(mesh: &mut SurfaceMesh) -> usize {
-    let before = mesh.triangles.len();
-    let mut seen = HashSet::with_capacity(before);
-    mesh.triangles.retain(|t| {
-        let mut key = *t;
+    let sorted = |t: [u32; 3]| {
+        let mut key = t;
         key.sort_unstable();
-        seen.insert(key)
+        key
+    };
+    let triangles = &mesh.triangles;
+    let groups = Rows::group_indexed(
+        mesh.vertex_count(),
+        triangles.len(),
+        |f| Some(sorted(triangles[f])[0] as usize),
+        |f| f as u32,
+    );
+    let mut copy = vec![false; triangles.len()];
+    for v in 0..groups.len() {
+        let group = groups.row(v);
+        for (k, &f) in group.iter().enumerate() {
+            let key = sorted(triangles[f as usize]);
+            copy[f as usize] = group[..k]
+                .iter()
+                .any(|&g| !copy[g as usize] && sorted(triangles[g as usize]) == key);
+        }
+    }
+    let before = mesh.triangles.len();
+    let mut f = 0;
+    mesh.triangles.retain(|_| {
+        f += 1;
+        !copy[f - 1]
     });
     before - mesh.triangles.len()
 }
@@ -25,6 +51,39 @@ pub fn remove_duplicate_faces(mesh: &mut SurfaceMesh) -> usize {
 mod tests {
     use super::*;
     use glam::DVec3;
+    use std::collections::HashSet;
+
+    /// The reference: a set of the sorted vertex triples seen so far.
+    fn reference_remove(mesh: &mut SurfaceMesh) -> usize {
+        let before = mesh.triangles.len();
+        let mut seen = HashSet::new();
+        mesh.triangles.retain(|t| {
+            let mut key = *t;
+            key.sort_unstable();
+            seen.insert(key)
+        });
+        before - mesh.triangles.len()
+    }
+
+    /// Random triangles over few vertices (many copies, in both orientations, some with
+    /// repeated corners): the same triangles removed as by the reference.
+    #[test]
+    fn grouping_removes_what_the_reference_removes() {
+        let mut rng = atlas_skin_runtime::random_pose::SplitMix64::new(9);
+        for n in [3u32, 5, 12] {
+            let mut pick = || (rng.next_f64() * n as f64) as u32;
+            let mesh = SurfaceMesh {
+                positions: vec![DVec3::ZERO; n as usize],
+                triangles: (0..200).map(|_| [pick(), pick(), pick()]).collect(),
+            };
+            let (mut fast, mut reference) = (mesh.clone(), mesh);
+            assert_eq!(
+                remove_duplicate_faces(&mut fast),
+                reference_remove(&mut reference)
+            );
+            assert_eq!(fast.triangles, reference.triangles);
+        }
+    }
 
     /// A doubled triangle, a flipped copy and a triangle sharing only an edge: the copies
     /// go, the others stay in order.

@@ -27,17 +27,19 @@ pub struct FaceSpheres {
 }
 
 /// Cells of side `cell` from `origin`, `dims` per axis; row k of `faces` lists the faces
-/// whose centre lies in cell k (x fastest).
+/// whose centre lies in cell k (x fastest). Also the grid of the joints of
+/// [`crate::skeleton::nearest_point`] (a "face" is then a point).
 #[derive(Debug, Clone, Default)]
-struct CentreGrid {
-    origin: DVec3,
-    cell: f64,
-    dims: IVec3,
+pub(crate) struct CentreGrid {
+    pub(crate) origin: DVec3,
+    pub(crate) cell: f64,
+    pub(crate) dims: IVec3,
     faces: Rows<u32>,
 }
 
 impl CentreGrid {
-    fn new(centres: &[DVec3]) -> Self {
+    /// About four centres per cell, at most 257 cells per axis.
+    pub(crate) fn new(centres: &[DVec3]) -> Self {
         let (lo, hi) = crate::geometry::bounding_box(centres);
         let extent = (hi - lo).max(DVec3::splat(1e-12));
         let target_cells = (centres.len() / 4).max(1) as f64;
@@ -66,7 +68,7 @@ impl CentreGrid {
         grid
     }
 
-    fn cell_of(&self, p: DVec3) -> IVec3 {
+    pub(crate) fn cell_of(&self, p: DVec3) -> IVec3 {
         ((p - self.origin) / self.cell)
             .floor()
             .as_ivec3()
@@ -86,7 +88,7 @@ impl CentreGrid {
     /// the cells of the box `skip_lo..=skip_hi` (pass an empty box to keep all). Cells
     /// x-adjacent are adjacent in `faces`, so each row of the box (or each side of the
     /// skipped box in a row) is one slice.
-    fn faces_in(
+    pub(crate) fn faces_in(
         &self,
         lo: IVec3,
         hi: IVec3,

@@ -27,58 +27,73 @@ pub struct Topology {
 }
 
 impl Topology {
-    /// Builds the topology of `mesh` in O(F log F).
+    /// Builds the topology of `mesh` in O(V + F): the half-edges are grouped by their
+    /// smaller vertex with a counting sort ([`Rows::group`], which keeps the stored order
+    /// (f, i) within a group), then each group, a few entries, is sorted stably by its
+    /// larger vertex, which gives the order (a, b, f, i) of edges and of their faces.
     pub fn new(mesh: &SurfaceMesh) -> Self {
         let nv = mesh.vertex_count();
-        let mut half: Vec<(u32, u32, u32, u8)> = Vec::with_capacity(mesh.triangles.len() * 3);
-        for (f, t) in mesh.triangles.iter().enumerate() {
-            for i in 0..3 {
-                let (a, b) = (t[i], t[(i + 1) % 3]);
-                half.push((a.min(b), a.max(b), f as u32, i as u8));
-            }
-        }
-        half.sort_unstable();
+        let triangles = &mesh.triangles;
+        let corner = |k: usize| triangles[k / 3][k % 3];
+        let next_corner = |k: usize| triangles[k / 3][(k + 1) % 3];
+        let mut half = Rows::group_indexed(
+            nv,
+            3 * triangles.len(),
+            |k| Some(corner(k).min(next_corner(k)) as usize),
+            |k| {
+                let (a, b) = (corner(k), next_corner(k));
+                (a.max(b), (k / 3) as u32, (k % 3) as u8)
+            },
+        );
         let mut edges = Vec::new();
         let mut face_edges = vec![[0u32; 3]; mesh.triangles.len()];
         let mut edge_face_offsets = vec![0u32];
-        let mut edge_faces = Vec::with_capacity(half.len());
-        for (k, &(a, b, f, i)) in half.iter().enumerate() {
-            if k == 0 || (half[k - 1].0, half[k - 1].1) != (a, b) {
-                if k > 0 {
-                    edge_face_offsets.push(edge_faces.len() as u32);
+        let mut edge_faces = Vec::with_capacity(half.values.len());
+        for a in 0..nv {
+            let group = &mut half.values[half.offsets[a] as usize..half.offsets[a + 1] as usize];
+            group.sort_by_key(|&(b, _, _)| b);
+            for (k, &(b, f, i)) in group.iter().enumerate() {
+                if k == 0 || group[k - 1].0 != b {
+                    if !edges.is_empty() {
+                        edge_face_offsets.push(edge_faces.len() as u32);
+                    }
+                    edges.push([a as u32, b]);
                 }
-                edges.push([a, b]);
+                face_edges[f as usize][i as usize] = edges.len() as u32 - 1;
+                edge_faces.push(f);
             }
-            face_edges[f as usize][i as usize] = edges.len() as u32 - 1;
-            edge_faces.push(f);
         }
-        if !half.is_empty() {
+        if !edges.is_empty() {
             edge_face_offsets.push(edge_faces.len() as u32);
         }
 
-        let (vertex_face_offsets, vertex_faces) = compress(
+        // Both row sets come sorted: a vertex's faces in stored order, its neighbours x < v
+        // (edges (x, v)) before those y > v (edges (v, y)), each in edge order.
+        let vertex_faces = Rows::group_indexed(
             nv,
-            mesh.triangles
-                .iter()
-                .enumerate()
-                .flat_map(|(f, t)| t.iter().map(move |&v| (v, f as u32))),
+            3 * triangles.len(),
+            |k| Some(corner(k) as usize),
+            |k| (k / 3) as u32,
         );
-        let (vertex_neighbor_offsets, vertex_neighbors) = compress(
+        // Entry 2e is edge e seen from its first end, 2e + 1 from its second.
+        let vertex_neighbors = Rows::group_indexed(
             nv,
-            edges
-                .iter()
-                .filter(|e| e[0] != e[1])
-                .flat_map(|e| [(e[0], e[1]), (e[1], e[0])]),
+            2 * edges.len(),
+            |k| {
+                let e = edges[k / 2];
+                (e[0] != e[1]).then_some(e[k % 2] as usize)
+            },
+            |k| edges[k / 2][1 - k % 2],
         );
         Self {
             edges,
             face_edges,
             edge_face_offsets,
             edge_faces,
-            vertex_face_offsets,
-            vertex_faces,
-            vertex_neighbor_offsets,
-            vertex_neighbors,
+            vertex_face_offsets: vertex_faces.offsets,
+            vertex_faces: vertex_faces.values,
+            vertex_neighbor_offsets: vertex_neighbors.offsets,
+            vertex_neighbors: vertex_neighbors.values,
         }
     }
 
@@ -132,15 +147,6 @@ impl Topology {
         }
         (label, count as usize)
     }
-}
-
-/// Groups `(key, value)` pairs into compressed rows over `0..n` keys, values sorted.
-fn compress(n: usize, pairs: impl Iterator<Item = (u32, u32)> + Clone) -> (Vec<u32>, Vec<u32>) {
-    let mut rows = Rows::group(n, pairs.map(|(k, v)| (k as usize, v)));
-    for i in 0..n {
-        rows.values[rows.offsets[i] as usize..rows.offsets[i + 1] as usize].sort_unstable();
-    }
-    (rows.offsets, rows.values)
 }
 
 /// Facts about one connected component.
@@ -322,6 +328,116 @@ mod tests {
         SurfaceMesh {
             positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z],
             triangles: vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
+        }
+    }
+
+    /// The reference: half-edges sorted as tuples (a, b, f, i), rows sorted one by one.
+    fn reference_topology(mesh: &SurfaceMesh) -> Topology {
+        let nv = mesh.vertex_count();
+        let mut half: Vec<(u32, u32, u32, u8)> = Vec::new();
+        for (f, t) in mesh.triangles.iter().enumerate() {
+            for i in 0..3 {
+                let (a, b) = (t[i], t[(i + 1) % 3]);
+                half.push((a.min(b), a.max(b), f as u32, i as u8));
+            }
+        }
+        half.sort_unstable();
+        let mut topology = Topology {
+            face_edges: vec![[0u32; 3]; mesh.triangles.len()],
+            edge_face_offsets: vec![0],
+            ..Topology::default()
+        };
+        for (k, &(a, b, f, i)) in half.iter().enumerate() {
+            if k > 0 && (half[k - 1].0, half[k - 1].1) != (a, b) {
+                topology
+                    .edge_face_offsets
+                    .push(topology.edge_faces.len() as u32);
+            }
+            if k == 0 || (half[k - 1].0, half[k - 1].1) != (a, b) {
+                topology.edges.push([a, b]);
+            }
+            topology.face_edges[f as usize][i as usize] = topology.edges.len() as u32 - 1;
+            topology.edge_faces.push(f);
+        }
+        if !half.is_empty() {
+            topology
+                .edge_face_offsets
+                .push(topology.edge_faces.len() as u32);
+        }
+        let sorted_rows = |pairs: Vec<(u32, u32)>| {
+            let mut rows = vec![Vec::new(); nv];
+            for (k, v) in pairs {
+                rows[k as usize].push(v);
+            }
+            let mut offsets = vec![0u32];
+            let mut values = Vec::new();
+            for mut row in rows {
+                row.sort_unstable();
+                values.extend(row);
+                offsets.push(values.len() as u32);
+            }
+            (offsets, values)
+        };
+        (topology.vertex_face_offsets, topology.vertex_faces) = sorted_rows(
+            mesh.triangles
+                .iter()
+                .enumerate()
+                .flat_map(|(f, t)| t.iter().map(move |&v| (v, f as u32)))
+                .collect(),
+        );
+        (topology.vertex_neighbor_offsets, topology.vertex_neighbors) = sorted_rows(
+            topology
+                .edges
+                .iter()
+                .filter(|e| e[0] != e[1])
+                .flat_map(|e| [(e[0], e[1]), (e[1], e[0])])
+                .collect(),
+        );
+        topology
+    }
+
+    /// Random triangles over few vertices (non-manifold edges, repeated corners, unused
+    /// vertices), the demo's welded surface and an empty mesh: the counting sort builds
+    /// the reference's topology.
+    #[test]
+    fn counting_sort_gives_the_reference_topology() {
+        let mut rng = atlas_skin_runtime::random_pose::SplitMix64::new(5);
+        let mut meshes = vec![
+            SurfaceMesh {
+                positions: vec![DVec3::ZERO; 3],
+                triangles: Vec::new(),
+            },
+            tetrahedron(),
+        ];
+        for n in [4, 9, 30] {
+            let mut pick = || (rng.next_f64() * n as f64) as u32;
+            meshes.push(SurfaceMesh {
+                positions: vec![DVec3::ZERO; n + 2],
+                triangles: (0..3 * n).map(|_| [pick(), pick(), pick()]).collect(),
+            });
+        }
+        let demo = crate::fixtures::demo::demo_character(0.03);
+        meshes.push(
+            crate::mesh::weld(
+                &demo.positions,
+                &demo.triangles,
+                crate::mesh::weld::DEFAULT_WELD_TOLERANCE,
+            )
+            .mesh,
+        );
+        for mesh in &meshes {
+            let (fast, reference) = (Topology::new(mesh), reference_topology(mesh));
+            assert_eq!(fast.edges, reference.edges);
+            assert_eq!(fast.face_edges, reference.face_edges);
+            assert_eq!(fast.edge_face_offsets, reference.edge_face_offsets);
+            assert_eq!(fast.edge_faces, reference.edge_faces);
+            assert_eq!(fast.vertex_face_offsets, reference.vertex_face_offsets);
+            assert_eq!(fast.vertex_faces, reference.vertex_faces);
+            assert_eq!(
+                fast.vertex_neighbor_offsets,
+                reference.vertex_neighbor_offsets
+            );
+            assert_eq!(fast.vertex_neighbors, reference.vertex_neighbors);
         }
     }
 

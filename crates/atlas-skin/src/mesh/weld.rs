@@ -9,7 +9,8 @@ use super::surface::SurfaceMesh;
 use super::union_find::UnionFind;
 use crate::geometry::bounding_box;
 use glam::{DVec3, Vec3};
-use std::collections::HashMap;
+use rustc_hash::FxHashMap;
+use std::collections::hash_map::Entry;
 
 /// The tolerance the corpus facts are computed with: 1e-6 × bounding-box diagonal.
 pub const DEFAULT_WELD_TOLERANCE: f64 = 1e-6;
@@ -33,7 +34,7 @@ pub struct Welded {
 /// Welds `positions` (#V stored) referenced by `triangles` (#F).
 ///
 /// Each welded vertex takes the position of its first stored vertex. Complexity: expected
-/// O(V) with a hash grid of cell size equal to the tolerance.
+/// O(V) with a hash grid (`close_pairs`).
 pub fn weld(positions: &[Vec3], triangles: &[[u32; 3]], relative_tolerance: f64) -> Welded {
     let stored: Vec<DVec3> = positions.iter().map(|p| p.as_dvec3()).collect();
     let mut referenced = vec![false; stored.len()];
@@ -42,54 +43,103 @@ pub fn weld(positions: &[Vec3], triangles: &[[u32; 3]], relative_tolerance: f64)
             referenced[v as usize] = true;
         }
     }
-    let used: Vec<DVec3> = (0..stored.len())
-        .filter(|&v| referenced[v])
-        .map(|v| stored[v])
+    let used: Vec<u32> = (0..stored.len() as u32)
+        .filter(|&v| referenced[v as usize])
         .collect();
-    let (lo, hi) = bounding_box(&used);
+    let (lo, hi) = bounding_box(used.iter().map(|&v| &stored[v as usize]));
     let tolerance = relative_tolerance * (hi - lo).length();
 
     let mut sets = UnionFind::new(stored.len());
     if tolerance > 0.0 {
-        let cell = |p: DVec3| ((p - lo) / tolerance).floor().as_ivec3();
-        let mut grid: HashMap<glam::IVec3, Vec<u32>> = HashMap::new();
-        for v in 0..stored.len() {
-            if !referenced[v] {
-                continue;
+        close_pairs(&stored, &used, lo, tolerance, |u, v| sets.union(u, v));
+    }
+    welded_from_sets(&stored, triangles, &used, &mut sets)
+}
+
+/// Calls `pair(u, v)` for every pair u < v of `used` vertices (in increasing order) at
+/// most `tolerance` apart (and possibly for others: the caller merges them only through
+/// union–find, where a pair found twice changes nothing, so every qualifying pair is
+/// reported at least once and no other).
+///
+/// A hash grid of cell size s = 2 × tolerance with origin `lo`: a point at offset x
+/// within its cell c along an axis (0 ≤ x < s) has every point within `tolerance` in
+/// cell c and in c − 1 when x < s / 2, c + 1 otherwise (a margin of 1/64 of a cell
+/// around s / 2 looks both ways, against rounding), so each vertex looks into 8 cells
+/// (27 at most), each a list threaded through `next`. Expected O(V).
+fn close_pairs(
+    stored: &[DVec3],
+    used: &[u32],
+    lo: DVec3,
+    tolerance: f64,
+    mut pair: impl FnMut(u32, u32),
+) {
+    const NONE: u32 = u32::MAX;
+    const MARGIN: f64 = 1.0 / 64.0;
+    let cell_size = 2.0 * tolerance;
+    let mut first_in_cell: FxHashMap<[i64; 3], u32> = FxHashMap::default();
+    first_in_cell.reserve(used.len());
+    let mut next = vec![NONE; stored.len()];
+    for &v in used {
+        let p = stored[v as usize];
+        let scaled = (p - lo) / cell_size;
+        let cell = scaled.floor();
+        let offset = scaled - cell;
+        let steps = |x: f64| -> &'static [i64] {
+            match (x < 0.5 + MARGIN, x > 0.5 - MARGIN) {
+                (true, true) => &[-1, 0, 1],
+                (true, false) => &[-1, 0],
+                _ => &[0, 1],
             }
-            let c = cell(stored[v]);
-            for dx in -1..=1 {
-                for dy in -1..=1 {
-                    for dz in -1..=1 {
-                        let Some(bucket) = grid.get(&(c + glam::IVec3::new(dx, dy, dz))) else {
-                            continue;
-                        };
-                        for &u in bucket {
-                            if stored[u as usize].distance(stored[v]) <= tolerance {
-                                sets.union(u, v as u32);
-                            }
+        };
+        let c = [cell.x as i64, cell.y as i64, cell.z as i64];
+        for &dx in steps(offset.x) {
+            for &dy in steps(offset.y) {
+                for &dz in steps(offset.z) {
+                    let key = [c[0] + dx, c[1] + dy, c[2] + dz];
+                    let Some(&head) = first_in_cell.get(&key) else {
+                        continue;
+                    };
+                    let mut u = head;
+                    while u != NONE {
+                        if stored[u as usize].distance(p) <= tolerance {
+                            pair(u, v);
                         }
+                        u = next[u as usize];
                     }
                 }
             }
-            grid.entry(c).or_default().push(v as u32);
+        }
+        match first_in_cell.entry(c) {
+            Entry::Occupied(mut head) => {
+                next[v as usize] = *head.get();
+                *head.get_mut() = v;
+            }
+            Entry::Vacant(slot) => {
+                slot.insert(v);
+            }
         }
     }
+}
 
+/// The [`Welded`] surface of the merged `sets`: welded vertices numbered by their first
+/// stored vertex, triangles in stored order.
+fn welded_from_sets(
+    stored: &[DVec3],
+    triangles: &[[u32; 3]],
+    used: &[u32],
+    sets: &mut UnionFind,
+) -> Welded {
     let mut welded_of_stored = vec![UNREFERENCED; stored.len()];
     let mut stored_of_welded = Vec::new();
-    let mut welded_of_root: HashMap<u32, u32> = HashMap::new();
-    for v in 0..stored.len() {
-        if !referenced[v] {
-            continue;
+    // Every set is represented by its smallest member, which comes first in `used`.
+    for &v in used {
+        let root = sets.find(v);
+        if root == v {
+            welded_of_stored[v as usize] = stored_of_welded.len() as u32;
+            stored_of_welded.push(v);
+        } else {
+            welded_of_stored[v as usize] = welded_of_stored[root as usize];
         }
-        let root = sets.find(v as u32);
-        let next = stored_of_welded.len() as u32;
-        let w = *welded_of_root.entry(root).or_insert_with(|| {
-            stored_of_welded.push(v as u32);
-            next
-        });
-        welded_of_stored[v] = w;
     }
     let mesh = SurfaceMesh {
         positions: stored_of_welded
@@ -112,6 +162,70 @@ pub fn weld(positions: &[Vec3], triangles: &[[u32; 3]], relative_tolerance: f64)
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    use atlas_skin_runtime::random_pose::SplitMix64;
+
+    /// The reference: every pair of referenced vertices compared, O(V²).
+    fn reference_weld(positions: &[Vec3], triangles: &[[u32; 3]], relative: f64) -> Welded {
+        let stored: Vec<DVec3> = positions.iter().map(|p| p.as_dvec3()).collect();
+        let mut used: Vec<u32> = triangles.iter().flatten().copied().collect();
+        used.sort_unstable();
+        used.dedup();
+        let (lo, hi) = bounding_box(used.iter().map(|&v| &stored[v as usize]));
+        let tolerance = relative * (hi - lo).length();
+        let mut sets = UnionFind::new(stored.len());
+        for (k, &u) in used.iter().enumerate() {
+            for &v in &used[k + 1..] {
+                if tolerance > 0.0 && stored[u as usize].distance(stored[v as usize]) <= tolerance {
+                    sets.union(u, v);
+                }
+            }
+        }
+        welded_from_sets(&stored, triangles, &used, &mut sets)
+    }
+
+    /// Clusters of points closer and farther than the tolerance, on cell boundaries and
+    /// off them, some unreferenced: the hash grid welds exactly as the reference.
+    #[test]
+    fn hash_grid_welds_as_the_reference() {
+        let mut rng = SplitMix64::new(17);
+        for case in 0..40 {
+            let relative = [1e-6, 1e-3, 0.05, 0.0][case % 4];
+            let mut positions = Vec::new();
+            for _ in 0..60 {
+                let centre = Vec3::new(
+                    rng.next_f64() as f32,
+                    rng.next_f64() as f32,
+                    (rng.next_f64() * 0.1) as f32,
+                );
+                // A cluster of up to 4 points at distances around the tolerance.
+                for _ in 0..1 + (rng.next_f64() * 4.0) as usize {
+                    let jitter = (rng.next_f64() * 3.0 * relative * 1.42) as f32;
+                    let axis = [Vec3::X, Vec3::Y, Vec3::Z][(rng.next_f64() * 3.0) as usize];
+                    let snapped = if case % 3 == 0 {
+                        centre
+                    } else {
+                        centre.round()
+                    };
+                    positions.push(snapped + axis * jitter);
+                }
+            }
+            let n = positions.len() as u32;
+            let triangles: Vec<[u32; 3]> = (0..n / 3)
+                .filter(|k| k % 7 != 3)
+                .map(|k| [3 * k, 3 * k + 1, (3 * k + 2) % n])
+                .collect();
+            let fast = weld(&positions, &triangles, relative);
+            let reference = reference_weld(&positions, &triangles, relative);
+            assert_eq!(
+                fast.welded_of_stored, reference.welded_of_stored,
+                "case {case}"
+            );
+            assert_eq!(fast.mesh.positions, reference.mesh.positions, "case {case}");
+            assert_eq!(fast.mesh.triangles, reference.mesh.triangles, "case {case}");
+            assert_eq!(fast.referenced_stored, reference.referenced_stored);
+        }
+    }
 
     #[test]
     fn seam_vertices_merge_and_unused_vertices_are_dropped() {

@@ -1,10 +1,11 @@
 //! What the method reads from the skeleton beyond the runtime's [`Skeleton`]
 //! (`atlas_skin_runtime`): bone segments and nearest bones ([`bones`]), a hierarchy for
-//! skeletons with several roots ([`hierarchy`]), whether the skeleton sits in the mesh
+//! skeletons with several roots ([`hierarchy`]), the nearest joint ([`nearest_point`]), whether the skeleton sits in the mesh
 //! ([`placement`]).
 //!
 //! [`Skeleton`]: atlas_skin_runtime::Skeleton
 
 pub mod bones;
 pub mod hierarchy;
+pub mod nearest_point;
 pub mod placement;

@@ -24,6 +24,7 @@ use crate::geometry::{point_segment_distance, segment_parameter};
 use crate::mesh::FaceSpheres;
 use crate::rows::{Rows, PAR_CHUNK};
 use crate::skeleton::bones::bone_segments;
+use crate::skeleton::nearest_point::SegmentGrid;
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
 
@@ -55,11 +56,18 @@ pub fn guard_far_bones(
         return 0;
     }
     let floor = NEAR_FLOOR * surface.diagonal();
+    // Each joint's segments, and a grid of all of them for the nearest (linear in the
+    // joints where bones are short, instead of a scan of every bone per vertex).
+    let mut segments_of_joint = vec![Vec::new(); skeleton.len()];
+    for &(j, a, b) in &segments {
+        segments_of_joint[j as usize].push([a, b]);
+    }
+    let all_segments: Vec<[DVec3; 2]> = segments.iter().map(|&(_, a, b)| [a, b]).collect();
+    let segment_grid = SegmentGrid::new(&all_segments);
     let joint_distance = |p: DVec3, joint: u32| {
-        segments
+        segments_of_joint[joint as usize]
             .iter()
-            .filter(|&&(j, _, _)| j == joint)
-            .map(|&(_, a, b)| point_segment_distance(p, a, b))
+            .map(|&[a, b]| point_segment_distance(p, a, b))
             .fold(f64::INFINITY, f64::min)
     };
     // Vertices with a joint that is far even from the nearest bone by straight line: only
@@ -67,10 +75,7 @@ pub fn guard_far_bones(
     let suspects: Vec<usize> = (0..weights.vertex_count())
         .filter(|&v| {
             let p = surface.positions[v];
-            let nearest = segments
-                .iter()
-                .map(|&(_, a, b)| point_segment_distance(p, a, b))
-                .fold(f64::INFINITY, f64::min);
+            let nearest = segment_grid.nearest_distance(p);
             let limit = FAR_BONE_RATIO * nearest.max(floor);
             weights.row(v).any(|(j, _)| joint_distance(p, j) > limit)
         })
