@@ -23,6 +23,10 @@ pub const INFLUENCE_BLOCK: usize = 8;
 ///   2.7); the vector loops blend only the first k_b influences of a block, the last of
 ///   them with the implicit weight `1 − Σ_{i<k_b−1} ω_i`, so a padded weight of 0 costs
 ///   nothing and the diagonal property above still holds.
+/// - `pairs`: every distinct (first joint, other joint) pair of a row, the pairs whose
+///   dual quaternion signs the blend compares; `hemisphere_forest`: a spanning forest of
+///   the graph these pairs make, as (aligned joint, joint to align) edges in breadth-first
+///   order ([`crate::SkinningPalette::align_hemispheres`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct CompactSkin {
     influences: usize,
@@ -30,6 +34,8 @@ pub struct CompactSkin {
     joints: Vec<u16>,
     weights: Vec<f32>,
     block_influences: Vec<u32>,
+    pairs: Vec<(u16, u16)>,
+    hemisphere_forest: Vec<(u16, u16)>,
 }
 
 impl CompactSkin {
@@ -58,6 +64,8 @@ impl CompactSkin {
             joints: Vec::with_capacity(vertex_count * influences),
             weights: Vec::with_capacity(vertex_count * (influences - 1)),
             block_influences: vec![1; vertex_count.div_ceil(INFLUENCE_BLOCK)],
+            pairs: Vec::new(),
+            hemisphere_forest: Vec::new(),
         };
         for v in 0..vertex_count {
             // ≤ K, the longest row: far below u32::MAX.
@@ -77,6 +85,15 @@ impl CompactSkin {
                 }
             }
         }
+        skin.pairs = skin
+            .joints
+            .chunks_exact(influences)
+            .flat_map(|row| row[1..].iter().map(move |&j| (row[0], j)))
+            .filter(|&(first, other)| first != other)
+            .collect();
+        skin.pairs.sort_unstable();
+        skin.pairs.dedup();
+        skin.hemisphere_forest = spanning_forest(joint_count, &skin.pairs);
         Ok(skin)
     }
 
@@ -110,6 +127,18 @@ impl CompactSkin {
         &self.block_influences
     }
 
+    /// Every distinct (first joint, other joint) pair of a row, first ≠ other.
+    pub fn pairs(&self) -> &[(u16, u16)] {
+        &self.pairs
+    }
+
+    /// Edges (aligned joint, joint to align) of a spanning forest of [`CompactSkin::pairs`]
+    /// in breadth-first order: following them in order, each joint is aligned against one
+    /// whose sign is already settled.
+    pub fn hemisphere_forest(&self) -> &[(u16, u16)] {
+        &self.hemisphere_forest
+    }
+
     /// The rows as [`VertexWeights`] (padding dropped, implicit weights written out): what
     /// the scalar reference in [`crate::reference`] needs to reproduce this skin.
     pub fn to_vertex_weights(&self) -> VertexWeights {
@@ -126,6 +155,50 @@ impl CompactSkin {
                 .collect::<Vec<_>>()
         }))
     }
+}
+
+/// A breadth-first spanning forest of the undirected graph on `joint_count` joints whose
+/// edges are `pairs`, as (reached from, reached) edges in the order reached; roots are the
+/// lowest-numbered joints of their components.
+fn spanning_forest(joint_count: usize, pairs: &[(u16, u16)]) -> Vec<(u16, u16)> {
+    // Adjacency in compressed rows: both directions of every pair.
+    let mut offsets = vec![0usize; joint_count + 1];
+    for &(a, b) in pairs {
+        offsets[usize::from(a) + 1] += 1;
+        offsets[usize::from(b) + 1] += 1;
+    }
+    for j in 0..joint_count {
+        offsets[j + 1] += offsets[j];
+    }
+    let mut next = offsets.clone();
+    let mut neighbours = vec![0u16; offsets[joint_count]];
+    for &(a, b) in pairs {
+        for (from, to) in [(a, b), (b, a)] {
+            neighbours[next[usize::from(from)]] = to;
+            next[usize::from(from)] += 1;
+        }
+    }
+    let mut reached = vec![false; joint_count];
+    let mut forest = Vec::new();
+    let mut queue = std::collections::VecDeque::new();
+    for root in 0..joint_count {
+        if reached[root] {
+            continue;
+        }
+        reached[root] = true;
+        queue.push_back(root);
+        while let Some(j) = queue.pop_front() {
+            for &n in &neighbours[offsets[j]..offsets[j + 1]] {
+                if !reached[usize::from(n)] {
+                    reached[usize::from(n)] = true;
+                    // Joint indices come from the u16 rows.
+                    forest.push((j as u16, n));
+                    queue.push_back(usize::from(n));
+                }
+            }
+        }
+    }
+    forest
 }
 
 #[cfg(test)]
@@ -196,6 +269,8 @@ mod tests {
         assert_eq!(&skin.joints()[..8], &[0, 2, 0, 0, 1, 1, 1, 1]);
         assert_eq!(&skin.weights()[..6], &[0.75, 0.25, 0.0, 1.0, 0.0, 0.0]);
         assert_eq!(skin.block_influences(), &[4]);
+        assert_eq!(skin.pairs(), &[(0, 2), (3, 0), (3, 1), (3, 2)]);
+        assert_eq!(skin.hemisphere_forest(), &[(0, 2), (0, 3), (3, 1)]);
         let back = skin.to_vertex_weights();
         assert_eq!(back.row(1).collect::<Vec<_>>(), vec![(1, 1.0)]);
         let row: Vec<_> = back.row(2).collect();

@@ -180,6 +180,41 @@ unsafe fn blend_dual_quaternions(
     (real, dual)
 }
 
+/// The blend `b̂ = Σ_i ω_i q̂_i` as one register `[real | dual]`, without the sign fix:
+/// for rows whose joints' real parts all have positive dot products with the first's
+/// ([`crate::SkinningPalette::hemispheres_agree`]), where every sign is +1. One load and
+/// one fused multiply-add per influence; the same sums in the same order as
+/// [`blend_dual_quaternions`].
+///
+/// # Safety
+/// As [`blend_dual_quaternions`].
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+unsafe fn blend_dual_quaternions_unsigned(
+    palette: *const f32,
+    joints: *const u16,
+    explicit: *const f32,
+    k: usize,
+) -> __m256 {
+    let quaternion = |i: usize| _mm256_loadu_ps(palette.add(8 * load_index(joints, i)));
+    let first = quaternion(0);
+    if k == 1 {
+        return first;
+    }
+    let mut sum = broadcast(explicit, 0);
+    let mut blended = _mm256_mul_ps(first, sum);
+    for i in 1..k - 1 {
+        let w = broadcast(explicit, i);
+        blended = _mm256_fmadd_ps(quaternion(i), w, blended);
+        sum = _mm256_add_ps(sum, w);
+    }
+    _mm256_fmadd_ps(
+        quaternion(k - 1),
+        _mm256_sub_ps(_mm256_set1_ps(1.0), sum),
+        blended,
+    )
+}
+
 /// [`blend_dual_quaternions`] of the first `used` influences of vertex `v` of a span with
 /// `k` influences per vertex.
 ///
@@ -473,13 +508,18 @@ unsafe fn dual_quaternion_span<const K: usize, const NORMALS: bool, const TANGEN
         span.len() / LANES * LANES
     };
     let rows = (joints, weights);
+    let unsigned = span.hemispheres_agree;
     for (start, (_, used)) in (0..batched).step_by(LANES).zip(span.blocks(k)) {
-        let blend: BatchBlend = match used {
-            1 => blend_batch::<1>,
-            2 => blend_batch::<2>,
-            3 => blend_batch::<3>,
-            4 => blend_batch::<4>,
-            _ => blend_batch::<0>,
+        let blend: BatchBlend = match (used, unsigned) {
+            (1, _) => blend_batch::<1, true>,
+            (2, false) => blend_batch::<2, false>,
+            (3, false) => blend_batch::<3, false>,
+            (4, false) => blend_batch::<4, false>,
+            (_, false) => blend_batch::<0, false>,
+            (2, true) => blend_batch::<2, true>,
+            (3, true) => blend_batch::<3, true>,
+            (4, true) => blend_batch::<4, true>,
+            (_, true) => blend_batch::<0, true>,
         };
         let batch = blend(palette, rows, start, k, used);
         let positions = span.rest_positions.as_ptr().add(start);
@@ -508,12 +548,14 @@ type BatchBlend =
     unsafe fn(*const f32, (*const u16, *const f32), usize, usize, usize) -> DualQuaternionBatch;
 
 /// The eight vertices from `start` blended over their first `USED` influences (or `used`
-/// when `USED` is 0).
+/// when `USED` is 0); `UNSIGNED`: without the sign fix
+/// ([`blend_dual_quaternions_unsigned`], also right for one influence).
 ///
 /// # Safety
-/// As [`blend_vertex`] for each of the eight vertices.
+/// As [`blend_vertex`] for each of the eight vertices; `UNSIGNED` only when the palette's
+/// hemispheres agree for these rows.
 #[target_feature(enable = "avx2,fma")]
-unsafe fn blend_batch<const USED: usize>(
+unsafe fn blend_batch<const USED: usize, const UNSIGNED: bool>(
     palette: *const f32,
     rows: (*const u16, *const f32),
     start: usize,
@@ -521,6 +563,25 @@ unsafe fn blend_batch<const USED: usize>(
     used: usize,
 ) -> DualQuaternionBatch {
     let used = if USED == 0 { used } else { USED };
+    if UNSIGNED {
+        let (joints, explicit) = rows;
+        let blend = |v: usize| {
+            blend_dual_quaternions_unsigned(
+                palette,
+                joints.add(v * k),
+                explicit.add(v * (k - 1)),
+                used,
+            )
+        };
+        let mut reals = [_mm256_setzero_ps(); LANES / 2];
+        let mut duals = [_mm256_setzero_ps(); LANES / 2];
+        for i in 0..LANES / 2 {
+            let (low, high) = (blend(start + i), blend(start + i + LANES / 2));
+            reals[i] = _mm256_permute2f128_ps::<0x20>(low, high);
+            duals[i] = _mm256_permute2f128_ps::<0x31>(low, high);
+        }
+        return DualQuaternionBatch::new(reals, duals);
+    }
     // Vertices i and i + 4 share a register (the transpose's input), built as soon as
     // both are blended: eight separate halves went through the stack and were read
     // back as whole registers, a store-to-load forwarding stall (measured: 10% of the

@@ -127,6 +127,9 @@ impl SkinningJob<'_> {
             joints: self.skin.joints(),
             weights: self.skin.weights(),
             block_influences: self.skin.block_influences(),
+            hemispheres_agree: set != InstructionSet::Portable
+                && self.palette.method() == SkinningMethod::DualQuaternion
+                && self.palette.hemispheres_agree(self.skin),
             rest_positions: self.rest_positions,
             rest_normals: self.rest_normals.unwrap_or_default(),
             rest_tangents: self.rest_tangents.unwrap_or_default(),
@@ -253,6 +256,10 @@ pub(crate) struct Span<'a> {
     pub(crate) weights: &'a [f32],
     /// [`CompactSkin::block_influences`] of the span, which starts at a block boundary.
     pub(crate) block_influences: &'a [u32],
+    /// For dual quaternions: every pair of joints of a row has real parts with a positive
+    /// dot product ([`SkinningPalette::hemispheres_agree`]), so the sign fix may be left
+    /// out.
+    pub(crate) hemispheres_agree: bool,
     pub(crate) rest_positions: &'a [Vec3],
     pub(crate) rest_normals: &'a [Vec3],
     pub(crate) rest_tangents: &'a [Vec4],
@@ -308,6 +315,7 @@ impl<'a> Span<'a> {
                 joints: joints_a,
                 weights: weights_a,
                 block_influences: blocks_a,
+                hemispheres_agree: self.hemispheres_agree,
                 rest_positions: rest_p_a,
                 rest_normals: rest_n_a,
                 rest_tangents: rest_t_a,
@@ -319,6 +327,7 @@ impl<'a> Span<'a> {
                 joints: joints_b,
                 weights: weights_b,
                 block_influences: blocks_b,
+                hemispheres_agree: self.hemispheres_agree,
                 rest_positions: rest_p_b,
                 rest_normals: rest_n_b,
                 rest_tangents: rest_t_b,
@@ -452,6 +461,7 @@ mod tests {
             joints: skin.joints(),
             weights: skin.weights(),
             block_influences: skin.block_influences(),
+            hemispheres_agree: false,
             rest_positions: rest,
             rest_normals: rest,
             rest_tangents: tangents,

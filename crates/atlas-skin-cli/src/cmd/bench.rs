@@ -255,6 +255,9 @@ impl Streams {
             palette
                 .update(pose, method)
                 .context("cannot skin the benchmark pose")?;
+            if method == SkinningMethod::DualQuaternion {
+                palette.align_hemispheres(&self.skin);
+            }
             SkinningJob {
                 skin: &self.skin,
                 palette,
