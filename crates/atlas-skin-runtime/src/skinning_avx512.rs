@@ -41,7 +41,28 @@ fn linear_blend_entry<const K: usize, const NORMALS: bool, const TANGENTS: bool>
     unsafe { linear_blend_span::<K, NORMALS>(palette, k, span) }
 }
 
-/// `Σ_i ω_i M_i`, the last weight `1 − Σ explicit`.
+/// `*x` in every lane, by a load that broadcasts (no shuffle unit): one instruction of
+/// inline assembly, as [`crate::skinning_avx2`]'s `broadcast`, for the same reason (as an
+/// intrinsic, LLVM loads neighbouring weights as one pair and splits it with shuffles).
+///
+/// # Safety
+/// AVX-512F present; `x[i]` readable.
+#[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2,fma")]
+#[inline]
+unsafe fn broadcast(x: *const f32, i: usize) -> __m512 {
+    let out: __m512;
+    std::arch::asm!(
+        "vbroadcastss {out}, dword ptr [{x} + {i} * 4]",
+        x = in(reg) x,
+        i = in(reg) i,
+        out = out(zmm_reg) out,
+        options(pure, readonly, nostack, preserves_flags),
+    );
+    out
+}
+
+/// `Σ_i ω_i M_i`, the last weight `1 − Σ explicit`, summed in every lane (no scalar
+/// weight is moved into a vector register by a shuffle).
 ///
 /// # Safety
 /// AVX-512F present; `joints` has `k` valid palette indices, `explicit` `k − 1` weights.
@@ -58,14 +79,18 @@ unsafe fn blend_matrices(
     if k == 1 {
         return blended;
     }
-    let mut sum = *explicit;
-    blended = _mm512_mul_ps(blended, _mm512_set1_ps(sum));
+    let mut sum = broadcast(explicit, 0);
+    blended = _mm512_mul_ps(blended, sum);
     for i in 1..k - 1 {
-        let w = *explicit.add(i);
-        blended = _mm512_fmadd_ps(matrix(i), _mm512_set1_ps(w), blended);
-        sum += w;
+        let w = broadcast(explicit, i);
+        blended = _mm512_fmadd_ps(matrix(i), w, blended);
+        sum = _mm512_add_ps(sum, w);
     }
-    _mm512_fmadd_ps(matrix(k - 1), _mm512_set1_ps(1.0 - sum), blended)
+    _mm512_fmadd_ps(
+        matrix(k - 1),
+        _mm512_sub_ps(_mm512_set1_ps(1.0), sum),
+        blended,
+    )
 }
 
 /// # Safety
