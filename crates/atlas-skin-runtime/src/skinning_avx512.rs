@@ -10,7 +10,9 @@
 //! summed by lane shuffles, measured 15% slower: it needs the one shuffle port five times
 //! per vertex.) The sums are the portable loop's (same blend order, implicit last weight).
 
-use crate::skinning_avx2::{half_products, load_index, sum_both_halves, sum_halves};
+use crate::skinning_avx2::{
+    broadcast_load, half_products, load_index, sum_both_halves, sum_halves,
+};
 use crate::skinning_job::{specialise, Kernel, Span};
 use glam::Mat4;
 use std::arch::x86_64::*;
@@ -41,25 +43,17 @@ fn linear_blend_entry<const K: usize, const NORMALS: bool, const TANGENTS: bool>
     unsafe { linear_blend_span::<K, NORMALS>(palette, k, span) }
 }
 
-/// `*x` in every lane, by a load that broadcasts (no shuffle unit): one instruction of
-/// inline assembly, as [`crate::skinning_avx2`]'s `broadcast`, for the same reason (as an
-/// intrinsic, LLVM loads neighbouring weights as one pair and splits it with shuffles).
-///
-/// # Safety
-/// AVX-512F present; `x[i]` readable.
-#[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2,fma")]
-#[inline]
-unsafe fn broadcast(x: *const f32, i: usize) -> __m512 {
-    let out: __m512;
-    std::arch::asm!(
-        "vbroadcastss {out}, dword ptr [{x} + {i} * 4]",
-        x = in(reg) x,
-        i = in(reg) i,
-        out = out(zmm_reg) out,
-        options(pure, readonly, nostack, preserves_flags),
-    );
-    out
-}
+broadcast_load!(
+    /// `*x` in every lane of a 512-bit register (LLVM would load neighbouring weights as
+    /// one pair and split it with shuffles).
+    ///
+    /// # Safety
+    /// AVX-512F present; `x[i]` readable.
+    #[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2,fma")]
+    broadcast,
+    __m512,
+    zmm_reg
+);
 
 /// `Σ_i ω_i M_i`, the last weight `1 − Σ explicit`, summed in every lane (no scalar
 /// weight is moved into a vector register by a shuffle).

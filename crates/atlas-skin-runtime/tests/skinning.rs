@@ -7,7 +7,7 @@ use atlas_skin_runtime::reference::{
 };
 use atlas_skin_runtime::{
     CompactSkin, InstructionSet, RuntimeError, SkinningJob, SkinningMethod, SkinningPalette,
-    Threading, VertexWeights,
+    Threading, VertexWeights, WeightFormat,
 };
 use glam::{Mat4, Quat, Vec3, Vec4};
 use proptest::prelude::*;
@@ -118,6 +118,15 @@ fn weights_strategy(vertices: usize, joints: u32) -> impl Strategy<Value = Verte
     .prop_map(VertexWeights::from_rows)
 }
 
+/// Every way a skin stores its weights.
+fn formats() -> impl Strategy<Value = WeightFormat> {
+    prop::sample::select(vec![
+        WeightFormat::Float32,
+        WeightFormat::Unorm16,
+        WeightFormat::Unorm8,
+    ])
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
@@ -132,11 +141,12 @@ proptest! {
         points in prop::collection::vec(prop::array::uniform3(-1.0f32..1.0), 300),
         max_influences in 1usize..7,
         parallel in any::<bool>(),
+        format in formats(),
     ) {
         let matrices: Vec<Mat4> = rotations.iter().zip(&translations).map(|(r, t)| rigid(*r, *t)).collect();
         let rest: Vec<Vec3> = points.iter().map(|p| Vec3::from(*p)).collect();
         let normals: Vec<Vec3> = rest.iter().map(|p| p.normalize_or(Vec3::Z)).collect();
-        let skin = CompactSkin::new(&rows, 6, max_influences).unwrap();
+        let skin = CompactSkin::with_format(&rows, 6, max_influences, format).unwrap();
         let reference_weights = skin.to_vertex_weights();
         let threading = if parallel { Threading::Parallel } else { Threading::Sequential };
         let mut expected_p = vec![Vec3::ZERO; rest.len()];
@@ -167,10 +177,11 @@ proptest! {
         rows in weights_strategy(200, 5),
         points in prop::collection::vec(prop::array::uniform3(-100.0f32..100.0), 200),
         max_influences in 1usize..7,
+        format in formats(),
     ) {
         let rest: Vec<Vec3> = points.iter().map(|p| Vec3::from(*p)).collect();
         let normals: Vec<Vec3> = rest.iter().map(|p| p.normalize_or(Vec3::Z)).collect();
-        let skin = CompactSkin::new(&rows, 5, max_influences).unwrap();
+        let skin = CompactSkin::with_format(&rows, 5, max_influences, format).unwrap();
         for method in [SkinningMethod::LinearBlend, SkinningMethod::DualQuaternion] {
             for (tangents, set) in [false, true].into_iter().flat_map(|t| supported_sets().into_iter().map(move |s| (t, s))) {
                 let posed = run_job(set, &skin, &[Mat4::IDENTITY; 5], method, Threading::Sequential, &rest, &normals, tangents).unwrap();
