@@ -5,7 +5,10 @@
 //! blending one influence is two fused multiply-adds; transforming `p` is
 //! `[c0 | c1]·[x x x x | y y y y] + [c2 | c3]·[z z z z | w w w w]` followed by adding the
 //! two halves. Dual quaternions are blended per vertex as two 128-bit registers (real,
-//! dual; one fused multiply-add each per influence), then eight vertices at a time are
+//! dual; one fused multiply-add each per influence, after the sign fix's dot product), or,
+//! when the palette's hemispheres agree for the skin, as one 256-bit register without the
+//! sign fix (one load and one fused multiply-add per influence, as linear blending), then
+//! eight vertices at a time are
 //! transposed to one register per component, normalised and applied with cross products
 //! (no matrix, no square root). The arithmetic is the portable loops' (same blend order,
 //! implicit last weight), so results agree with them to round-off and an identity palette

@@ -50,6 +50,12 @@ pub enum Threading {
 /// [`SkinningJob::run`] checks only buffer lengths (O(1)); the skin and the palette were
 /// validated when built, and the loop then trusts them and allocates nothing.
 ///
+/// For dual quaternions, [`SkinningPalette::align_hemispheres`] after each palette update
+/// lets the vector loops leave out the per-influence sign fix (checked per run, O(pairs)
+/// of [`CompactSkin::pairs`]; the result is the same). A skin with quantised weights
+/// ([`crate::WeightFormat`]) is run 64 vertices at a time, each piece's weights widened
+/// to floats on the stack first.
+///
 /// The loop is specialised per influence count and stream set, and comes in the
 /// [`InstructionSet`] families: [`SkinningJob::run`] takes the widest this CPU runs
 /// (detected at run time), [`SkinningJob::run_with`] the one given. All do the same sums

@@ -68,7 +68,7 @@ pub struct Args {
     /// (fewer bytes per frame, weights rounded to 1.5e-5 or 3.9e-3).
     #[arg(long, value_name = "FORMAT", default_value = "f32",
           value_parser = ["f32", "unorm16", "unorm8"])]
-    pub weights: String,
+    pub weight_format: String,
     /// Print the figures as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -88,8 +88,8 @@ pub struct BenchReport {
     pub batch: usize,
     /// The skinning loops that ran ([`InstructionSet::name`]).
     pub instruction_set: &'static str,
-    /// How the skin stored its weights (`--weights`).
-    pub weights: String,
+    /// How the skin stored its weights (`--weight-format`).
+    pub weight_format: String,
     pub influences: usize,
     pub lbs_vertices_per_second: f64,
     pub dqs_vertices_per_second: f64,
@@ -116,8 +116,8 @@ pub fn run(args: Args) -> Result<()> {
         .as_ref()
         .context("the character has no skin weights")?;
     let count = args.vertices.unwrap_or(posable.rest_positions.len());
-    let format = WeightFormat::from_name(&args.weights)
-        .with_context(|| format!("unknown weight format {:?}", args.weights))?;
+    let format = WeightFormat::from_name(&args.weight_format)
+        .with_context(|| format!("unknown weight format {:?}", args.weight_format))?;
     let mut streams = Streams::replicate(&posable, weights, count, format)?;
     let palettes: Vec<Vec<Mat4>> = (0..POSES as u64)
         .map(|seed| {
@@ -166,7 +166,7 @@ pub fn run(args: Args) -> Result<()> {
         frames: args.frames,
         batch: args.batch,
         instruction_set: set.name(),
-        weights: args.weights.clone(),
+        weight_format: args.weight_format.clone(),
         influences: streams.skin.influences(),
         lbs_vertices_per_second: lbs_rate,
         dqs_vertices_per_second: dqs_rate,
@@ -186,7 +186,7 @@ pub fn run(args: Args) -> Result<()> {
 fn print_report(r: &BenchReport) {
     println!(
         "{} vertices, {} influences ({} weights), {} thread(s), {} loops, {} samples of {} frame(s) per method",
-        r.vertices, r.influences, r.weights, r.threads, r.instruction_set, r.frames, r.batch
+        r.vertices, r.influences, r.weight_format, r.threads, r.instruction_set, r.frames, r.batch
     );
     println!(
         "linear blend:    {:8.1} M vertices/s ({:.0}% of copy bandwidth)",
