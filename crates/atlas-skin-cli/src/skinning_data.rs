@@ -56,23 +56,19 @@ pub fn encode(
             floats(&mut bytes, &v.to_array());
         }
     }
-    let rows = |v: usize| {
-        let joints = &skin.joints()[v * k..(v + 1) * k];
-        let explicit = &skin.weights()[v * (k - 1)..(v + 1) * (k - 1)];
-        (joints, explicit)
-    };
     for v in 0..n {
-        let (joints, _) = rows(v);
+        let joints = &skin.joints()[v * k..(v + 1) * k];
         for i in 0..DATA_INFLUENCES {
             let joint = joints.get(i).copied().unwrap_or(joints[0]);
             bytes.extend(joint.to_le_bytes());
         }
     }
     for v in 0..n {
-        let (_, explicit) = rows(v);
         let mut weights = [0.0f32; DATA_INFLUENCES];
-        weights[..k - 1].copy_from_slice(explicit);
-        weights[k - 1] = 1.0 - explicit.iter().sum::<f32>();
+        for (w, explicit) in weights.iter_mut().zip(skin.explicit_weights(v)) {
+            *w = explicit;
+        }
+        weights[k - 1] = 1.0 - weights[..k - 1].iter().sum::<f32>();
         floats(&mut bytes, &weights);
     }
     for m in palette {

@@ -13,7 +13,7 @@ fn atlas_skin(args: &[&str]) -> String {
     String::from_utf8(atlas_skin_ok(args).stdout).expect("UTF-8 output")
 }
 
-fn bench_json(threads: &str) -> Value {
+fn bench_json(threads: &str, weight_format: &str) -> Value {
     let text = atlas_skin(&[
         "bench",
         "--json",
@@ -23,21 +23,28 @@ fn bench_json(threads: &str) -> Value {
         "20000",
         "--frames",
         "3",
+        "--weight-format",
+        weight_format,
     ]);
     serde_json::from_str(&text).expect("one JSON object")
 }
 
-/// The JSON report has every figure the issue names, for the requested size and threads.
+/// The JSON report has every figure the issue names, for the requested size, threads and
+/// weight format (8-bit weights: 3 bytes fewer per explicit weight).
 /// (That a frame allocates nothing is the runtime's `tests/no_allocation.rs`.)
 #[test]
 fn bench_runs_on_the_demo_character() {
-    let single = bench_json("1");
+    let single = bench_json("1", "f32");
     assert_eq!(single["threads"], 1, "{single}");
-    let report = bench_json("2");
+    assert_eq!(single["weight_format"], "f32", "{single}");
+    let report = bench_json("2", "unorm8");
     assert_eq!(report["vertices"], 20_000, "{report}");
     assert_eq!(report["threads"], 2, "{report}");
+    assert_eq!(report["weight_format"], "unorm8", "{report}");
     let influences = report["influences"].as_u64().expect("influences");
     assert!((1..=4).contains(&influences), "{report}");
+    let bytes = |r: &Value| r["bytes_per_vertex"].as_u64().expect("bytes per vertex");
+    assert_eq!(bytes(&single) - bytes(&report), 3 * (influences - 1));
     for key in [
         "lbs_vertices_per_second",
         "dqs_vertices_per_second",
@@ -150,8 +157,10 @@ fn bench_writes_side_by_side_data() {
         message.contains(folder.to_str().expect("UTF-8 path")),
         "{message}"
     );
-    let failed = support::atlas_skin(&["bench", "--frames", "1", "--instruction-set", "sse9"]);
-    assert!(!failed.status.success());
-    let message = String::from_utf8_lossy(&failed.stderr);
-    assert!(message.contains("\"sse9\""), "{message}");
+    for (flag, value) in [("--instruction-set", "sse9"), ("--weight-format", "f16")] {
+        let failed = support::atlas_skin(&["bench", "--frames", "1", flag, value]);
+        assert!(!failed.status.success());
+        let message = String::from_utf8_lossy(&failed.stderr);
+        assert!(message.contains(value), "{flag}: {message}");
+    }
 }

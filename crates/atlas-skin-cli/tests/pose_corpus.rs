@@ -2,7 +2,8 @@
 //! 1e-5 of the bounding-box diagonal on every corpus model with weights, for linear blend
 //! and dual quaternion skinning of seeded random poses, sequential and parallel, with and
 //! without normals, with every instruction set this CPU runs (the portable loops always:
-//! what a CPU without AVX2 or AVX-512 runs).
+//! what a CPU without AVX2 or AVX-512 runs), with float and quantised weights; and what
+//! quantising the weights costs in accuracy (`QUANTISED_ERROR`).
 
 use atlas_skin_io::LoadOptions;
 use atlas_skin_runtime::pose::palette_from_world;
@@ -13,6 +14,7 @@ use atlas_skin_runtime::reference::{
 };
 use atlas_skin_runtime::{
     CompactSkin, InstructionSet, Rig, SkinningJob, SkinningMethod, SkinningPalette, Threading,
+    WeightFormat,
 };
 use glam::{Mat4, Vec3};
 use std::path::Path;
@@ -70,8 +72,19 @@ fn max_distance(a: &[Vec3], b: &[Vec3]) -> f32 {
         .fold(0.0, f32::max)
 }
 
+/// Largest distance, in units of the bounding-box diagonal, between the reference
+/// deformation with quantised weights and with the float weights they come from, over the
+/// corpus, its seeded poses and both methods (the figure docs state for `--weights`).
+const QUANTISED_ERROR: [(WeightFormat, f32); 2] = [
+    (WeightFormat::Unorm16, 1e-5),
+    (WeightFormat::Unorm8, 2.5e-3),
+];
+
 #[test]
 fn fast_paths_match_the_reference_on_the_corpus() {
+    let mut quantised_error = [0.0f32; 2];
+    // Aligned palettes whose every pair agreed (the loops without the sign fix ran), of all.
+    let (mut agreed, mut aligned_palettes) = (0, 0);
     for (folder, input, skeleton, group, weights) in CORPUS {
         let dir = Path::new(MODELS).join(folder);
         let path = dir.join(input);
@@ -94,10 +107,19 @@ fn fast_paths_match_the_reference_on_the_corpus() {
             .map(|p| (*p - rest[0]).normalize_or(Vec3::Y))
             .collect();
         // Elephant rows have up to 23 influences: the N path with 8.
-        for max_influences in [4, 8] {
-            let skin =
-                CompactSkin::new(rows, skeleton.len(), max_influences).expect("valid weights");
+        for (max_influences, format) in [
+            (4, WeightFormat::Float32),
+            (8, WeightFormat::Float32),
+            (4, WeightFormat::Unorm16),
+            (8, WeightFormat::Unorm8),
+        ] {
+            let skin = CompactSkin::with_format(rows, skeleton.len(), max_influences, format)
+                .expect("valid weights");
             let reference_weights = skin.to_vertex_weights();
+            let float_weights = CompactSkin::new(rows, skeleton.len(), max_influences)
+                .expect("valid weights")
+                .to_vertex_weights();
+            let quantised_slot = QUANTISED_ERROR.iter().position(|&(f, _)| f == format);
             let tolerance = 1e-5 * diagonal(rest);
             for seed in 0..3 {
                 let mut local = rig.rest.clone();
@@ -111,40 +133,41 @@ fn fast_paths_match_the_reference_on_the_corpus() {
                 rig.world(&local, &mut node_world);
                 rig.joint_world(&node_world, &mut joint_world);
                 palette_from_world(&joint_world, &skeleton.inverse_bind, &mut matrices);
-                for method in [SkinningMethod::LinearBlend, SkinningMethod::DualQuaternion] {
+                // Dual quaternions as converted, and with their hemispheres aligned to the
+                // skin (the vector loops then leave out the sign fix where every pair agrees).
+                for (method, aligned) in [
+                    (SkinningMethod::LinearBlend, false),
+                    (SkinningMethod::DualQuaternion, false),
+                    (SkinningMethod::DualQuaternion, true),
+                ] {
                     let mut palette = SkinningPalette::new(skeleton.len());
                     palette.update(&matrices, method).expect("rigid palette");
+                    if aligned {
+                        palette.align_hemispheres(&skin);
+                        agreed += usize::from(palette.hemispheres_agree(&skin));
+                        aligned_palettes += 1;
+                    }
                     let mut expected = vec![Vec3::ZERO; rest.len()];
                     let mut expected_normals = vec![Vec3::ZERO; rest.len()];
-                    match method {
-                        SkinningMethod::LinearBlend => {
-                            linear_blend_positions(
-                                rest,
-                                &reference_weights,
-                                &matrices,
-                                &mut expected,
-                            );
-                            linear_blend_vectors(
-                                &normals,
-                                &reference_weights,
-                                &matrices,
-                                &mut expected_normals,
-                            );
-                        }
-                        SkinningMethod::DualQuaternion => {
-                            dual_quaternion_positions(
-                                rest,
-                                &reference_weights,
-                                &matrices,
-                                &mut expected,
-                            );
-                            dual_quaternion_vectors(
-                                &normals,
-                                &reference_weights,
-                                &matrices,
-                                &mut expected_normals,
-                            );
-                        }
+                    // The scalar reference of `method` with these weights: positions, normals.
+                    let reference =
+                        |weights, positions: &mut [Vec3], vectors: &mut [Vec3]| match method {
+                            SkinningMethod::LinearBlend => {
+                                linear_blend_positions(rest, weights, &matrices, positions);
+                                linear_blend_vectors(&normals, weights, &matrices, vectors);
+                            }
+                            SkinningMethod::DualQuaternion => {
+                                dual_quaternion_positions(rest, weights, &matrices, positions);
+                                dual_quaternion_vectors(&normals, weights, &matrices, vectors);
+                            }
+                        };
+                    reference(&reference_weights, &mut expected, &mut expected_normals);
+                    if let Some(slot) = quantised_slot {
+                        let mut float_expected = vec![Vec3::ZERO; rest.len()];
+                        let mut float_normals = vec![Vec3::ZERO; rest.len()];
+                        reference(&float_weights, &mut float_expected, &mut float_normals);
+                        let error = max_distance(&expected, &float_expected) / diagonal(rest);
+                        quantised_error[slot] = quantised_error[slot].max(error);
                     }
                     let sets = InstructionSet::ALL.into_iter().filter(|s| s.is_supported());
                     for (set, threading, with_normals) in sets.flat_map(|set| {
@@ -168,7 +191,7 @@ fn fast_paths_match_the_reference_on_the_corpus() {
                         .run_with(set)
                         .expect("valid job");
                         let what = format!(
-                            "{folder}, K ≤ {max_influences}, seed {seed}, {method:?}, {threading:?}, {}, normals {with_normals}",
+                            "{folder}, K ≤ {max_influences} ({format:?}), seed {seed}, {method:?} (aligned {aligned}), {threading:?}, {}, normals {with_normals}",
                             set.name()
                         );
                         let error = max_distance(&positions, &expected);
@@ -181,5 +204,14 @@ fn fast_paths_match_the_reference_on_the_corpus() {
                 }
             }
         }
+    }
+    eprintln!("{agreed} of {aligned_palettes} aligned palettes agree on every pair");
+    assert!(
+        agreed > 0,
+        "no corpus pose ran the loops without the sign fix"
+    );
+    for ((format, bound), error) in QUANTISED_ERROR.iter().zip(quantised_error) {
+        eprintln!("{format:?} weights move the corpus by at most {error:.2e} of the diagonal");
+        assert!(error <= *bound, "{format:?}: {error} > {bound}");
     }
 }

@@ -53,6 +53,10 @@ pub enum RuntimeError {
     },
     #[error("vertex {vertex} has no influence with a positive weight")]
     UnweightedVertex { vertex: usize },
+    #[error(
+        "the skin has {influences} influences per vertex; quantised weights hold at most {max}"
+    )]
+    TooManyQuantisedInfluences { influences: usize, max: usize },
     #[error("the skeleton has {count} joints; compact skins index at most 65536")]
     TooManyJoints { count: usize },
     #[error("no joint name in common between the motion (joints like {source_joint:?}) and the character (joints like {target_joint:?})")]

@@ -27,7 +27,7 @@ pub mod skinning_palette;
 pub mod weights;
 
 pub use animation::{Clip, Interpolation, Property, Rig, Track, Trs};
-pub use compact_skin::CompactSkin;
+pub use compact_skin::{CompactSkin, WeightFormat};
 pub use dual_quaternion::DualQuat;
 pub use error::RuntimeError;
 pub use instruction_set::InstructionSet;

@@ -5,7 +5,10 @@
 //! blending one influence is two fused multiply-adds; transforming `p` is
 //! `[c0 | c1]·[x x x x | y y y y] + [c2 | c3]·[z z z z | w w w w]` followed by adding the
 //! two halves. Dual quaternions are blended per vertex as two 128-bit registers (real,
-//! dual; one fused multiply-add each per influence), then eight vertices at a time are
+//! dual; one fused multiply-add each per influence, after the sign fix's dot product), or,
+//! when the palette's hemispheres agree for the skin, as one 256-bit register without the
+//! sign fix (one load and one fused multiply-add per influence, as linear blending), then
+//! eight vertices at a time are
 //! transposed to one register per component, normalised and applied with cross products
 //! (no matrix, no square root). The arithmetic is the portable loops' (same blend order,
 //! implicit last weight), so results agree with them to round-off and an identity palette
@@ -56,28 +59,43 @@ fn dual_quaternion_entry<const K: usize, const NORMALS: bool, const TANGENTS: bo
     unsafe { dual_quaternion_span::<K, NORMALS, TANGENTS>(palette, k, span) }
 }
 
-/// `*x` in every lane, by a load that broadcasts (no shuffle unit).
+/// Defines `unsafe fn $name(x: *const f32, i: usize) -> $ty`: `x[i]` in every lane of a
+/// `$ty` register by one broadcasting load (no shuffle unit), for the target features
+/// given as attributes (AVX present; `x[i]` readable).
 ///
 /// Written as one instruction of inline assembly: as an intrinsic, LLVM merges broadcasts
-/// that meet in a blend, or that are summed, into scalar loads and shuffles, which moves
-/// the work back onto the one port that shuffles (measured: the loop then runs 15% faster
-/// than before instead of 40%).
-///
-/// # Safety
-/// AVX present; `x[i]` readable.
-#[target_feature(enable = "avx2,fma")]
-#[inline]
-unsafe fn broadcast(x: *const f32, i: usize) -> __m256 {
-    let out: __m256;
-    std::arch::asm!(
-        "vbroadcastss {out}, dword ptr [{x} + {i} * 4]",
-        x = in(reg) x,
-        i = in(reg) i,
-        out = out(ymm_reg) out,
-        options(pure, readonly, nostack, preserves_flags),
-    );
-    out
+/// that meet in a blend, or that are summed, into scalar loads and shuffles (neighbouring
+/// weights loaded as one pair and split), which moves the work back onto the one port that
+/// shuffles (measured: the loop then runs 15% faster than before instead of 40%).
+macro_rules! broadcast_load {
+    ($(#[$attribute:meta])* $name:ident, $ty:ty, $register:ident) => {
+        $(#[$attribute])*
+        #[inline]
+        unsafe fn $name(x: *const f32, i: usize) -> $ty {
+            let out: $ty;
+            std::arch::asm!(
+                "vbroadcastss {out}, dword ptr [{x} + {i} * 4]",
+                x = in(reg) x,
+                i = in(reg) i,
+                out = out($register) out,
+                options(pure, readonly, nostack, preserves_flags),
+            );
+            out
+        }
+    };
 }
+pub(crate) use broadcast_load;
+
+broadcast_load!(
+    /// `*x` in every lane of a 256-bit register.
+    ///
+    /// # Safety
+    /// AVX present; `x[i]` readable.
+    #[target_feature(enable = "avx2,fma")]
+    broadcast,
+    __m256,
+    ymm_reg
+);
 
 /// `*j` zero-extended, by one scalar load: as plain Rust, LLVM loads the four indices of
 /// a vertex as one vector and extracts them with shuffles.
@@ -178,6 +196,41 @@ unsafe fn blend_dual_quaternions(
     }
     add(quaternion(k - 1), _mm_sub_ps(_mm_set1_ps(1.0), sum));
     (real, dual)
+}
+
+/// The blend `b̂ = Σ_i ω_i q̂_i` as one register `[real | dual]`, without the sign fix:
+/// for rows whose joints' real parts all have positive dot products with the first's
+/// ([`crate::SkinningPalette::hemispheres_agree`]), where every sign is +1. One load and
+/// one fused multiply-add per influence; the same sums in the same order as
+/// [`blend_dual_quaternions`].
+///
+/// # Safety
+/// As [`blend_dual_quaternions`].
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+unsafe fn blend_dual_quaternions_unsigned(
+    palette: *const f32,
+    joints: *const u16,
+    explicit: *const f32,
+    k: usize,
+) -> __m256 {
+    let quaternion = |i: usize| _mm256_loadu_ps(palette.add(8 * load_index(joints, i)));
+    let first = quaternion(0);
+    if k == 1 {
+        return first;
+    }
+    let mut sum = broadcast(explicit, 0);
+    let mut blended = _mm256_mul_ps(first, sum);
+    for i in 1..k - 1 {
+        let w = broadcast(explicit, i);
+        blended = _mm256_fmadd_ps(quaternion(i), w, blended);
+        sum = _mm256_add_ps(sum, w);
+    }
+    _mm256_fmadd_ps(
+        quaternion(k - 1),
+        _mm256_sub_ps(_mm256_set1_ps(1.0), sum),
+        blended,
+    )
 }
 
 /// [`blend_dual_quaternions`] of the first `used` influences of vertex `v` of a span with
@@ -473,13 +526,18 @@ unsafe fn dual_quaternion_span<const K: usize, const NORMALS: bool, const TANGEN
         span.len() / LANES * LANES
     };
     let rows = (joints, weights);
+    let unsigned = span.hemispheres_agree;
     for (start, (_, used)) in (0..batched).step_by(LANES).zip(span.blocks(k)) {
-        let blend: BatchBlend = match used {
-            1 => blend_batch::<1>,
-            2 => blend_batch::<2>,
-            3 => blend_batch::<3>,
-            4 => blend_batch::<4>,
-            _ => blend_batch::<0>,
+        let blend: BatchBlend = match (used, unsigned) {
+            (1, _) => blend_batch::<1, true>,
+            (2, false) => blend_batch::<2, false>,
+            (3, false) => blend_batch::<3, false>,
+            (4, false) => blend_batch::<4, false>,
+            (_, false) => blend_batch::<0, false>,
+            (2, true) => blend_batch::<2, true>,
+            (3, true) => blend_batch::<3, true>,
+            (4, true) => blend_batch::<4, true>,
+            (_, true) => blend_batch::<0, true>,
         };
         let batch = blend(palette, rows, start, k, used);
         let positions = span.rest_positions.as_ptr().add(start);
@@ -508,12 +566,14 @@ type BatchBlend =
     unsafe fn(*const f32, (*const u16, *const f32), usize, usize, usize) -> DualQuaternionBatch;
 
 /// The eight vertices from `start` blended over their first `USED` influences (or `used`
-/// when `USED` is 0).
+/// when `USED` is 0); `UNSIGNED`: without the sign fix
+/// ([`blend_dual_quaternions_unsigned`], also right for one influence).
 ///
 /// # Safety
-/// As [`blend_vertex`] for each of the eight vertices.
+/// As [`blend_vertex`] for each of the eight vertices; `UNSIGNED` only when the palette's
+/// hemispheres agree for these rows.
 #[target_feature(enable = "avx2,fma")]
-unsafe fn blend_batch<const USED: usize>(
+unsafe fn blend_batch<const USED: usize, const UNSIGNED: bool>(
     palette: *const f32,
     rows: (*const u16, *const f32),
     start: usize,
@@ -521,6 +581,25 @@ unsafe fn blend_batch<const USED: usize>(
     used: usize,
 ) -> DualQuaternionBatch {
     let used = if USED == 0 { used } else { USED };
+    if UNSIGNED {
+        let (joints, explicit) = rows;
+        let blend = |v: usize| {
+            blend_dual_quaternions_unsigned(
+                palette,
+                joints.add(v * k),
+                explicit.add(v * (k - 1)),
+                used,
+            )
+        };
+        let mut reals = [_mm256_setzero_ps(); LANES / 2];
+        let mut duals = [_mm256_setzero_ps(); LANES / 2];
+        for i in 0..LANES / 2 {
+            let (low, high) = (blend(start + i), blend(start + i + LANES / 2));
+            reals[i] = _mm256_permute2f128_ps::<0x20>(low, high);
+            duals[i] = _mm256_permute2f128_ps::<0x31>(low, high);
+        }
+        return DualQuaternionBatch::new(reals, duals);
+    }
     // Vertices i and i + 4 share a register (the transpose's input), built as soon as
     // both are blended: eight separate halves went through the stack and were read
     // back as whole registers, a store-to-load forwarding stall (measured: 10% of the

@@ -10,7 +10,9 @@
 //! summed by lane shuffles, measured 15% slower: it needs the one shuffle port five times
 //! per vertex.) The sums are the portable loop's (same blend order, implicit last weight).
 
-use crate::skinning_avx2::{half_products, load_index, sum_both_halves, sum_halves};
+use crate::skinning_avx2::{
+    broadcast_load, half_products, load_index, sum_both_halves, sum_halves,
+};
 use crate::skinning_job::{specialise, Kernel, Span};
 use glam::Mat4;
 use std::arch::x86_64::*;
@@ -41,7 +43,20 @@ fn linear_blend_entry<const K: usize, const NORMALS: bool, const TANGENTS: bool>
     unsafe { linear_blend_span::<K, NORMALS>(palette, k, span) }
 }
 
-/// `Σ_i ω_i M_i`, the last weight `1 − Σ explicit`.
+broadcast_load!(
+    /// `*x` in every lane of a 512-bit register (LLVM would load neighbouring weights as
+    /// one pair and split it with shuffles).
+    ///
+    /// # Safety
+    /// AVX-512F present; `x[i]` readable.
+    #[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2,fma")]
+    broadcast,
+    __m512,
+    zmm_reg
+);
+
+/// `Σ_i ω_i M_i`, the last weight `1 − Σ explicit`, summed in every lane (no scalar
+/// weight is moved into a vector register by a shuffle).
 ///
 /// # Safety
 /// AVX-512F present; `joints` has `k` valid palette indices, `explicit` `k − 1` weights.
@@ -58,14 +73,18 @@ unsafe fn blend_matrices(
     if k == 1 {
         return blended;
     }
-    let mut sum = *explicit;
-    blended = _mm512_mul_ps(blended, _mm512_set1_ps(sum));
+    let mut sum = broadcast(explicit, 0);
+    blended = _mm512_mul_ps(blended, sum);
     for i in 1..k - 1 {
-        let w = *explicit.add(i);
-        blended = _mm512_fmadd_ps(matrix(i), _mm512_set1_ps(w), blended);
-        sum += w;
+        let w = broadcast(explicit, i);
+        blended = _mm512_fmadd_ps(matrix(i), w, blended);
+        sum = _mm512_add_ps(sum, w);
     }
-    _mm512_fmadd_ps(matrix(k - 1), _mm512_set1_ps(1.0 - sum), blended)
+    _mm512_fmadd_ps(
+        matrix(k - 1),
+        _mm512_sub_ps(_mm512_set1_ps(1.0), sum),
+        blended,
+    )
 }
 
 /// # Safety

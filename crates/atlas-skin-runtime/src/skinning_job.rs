@@ -1,7 +1,9 @@
 //! Deforming a mesh by a palette: linear blend and dual quaternion skinning over
 //! caller-owned buffers (the shape of ozz-animation's SkinningJob).
 
-use crate::compact_skin::{CompactSkin, INFLUENCE_BLOCK};
+use crate::compact_skin::{
+    unorm16, unorm8, CompactSkin, StoredWeights, INFLUENCE_BLOCK, MAX_QUANTISED_INFLUENCES,
+};
 use crate::dual_quaternion::DualQuat;
 use crate::instruction_set::InstructionSet;
 use crate::skinning_palette::{SkinningMethod, SkinningPalette};
@@ -47,6 +49,12 @@ pub enum Threading {
 ///
 /// [`SkinningJob::run`] checks only buffer lengths (O(1)); the skin and the palette were
 /// validated when built, and the loop then trusts them and allocates nothing.
+///
+/// For dual quaternions, [`SkinningPalette::align_hemispheres`] after each palette update
+/// lets the vector loops leave out the per-influence sign fix (checked per run, O(pairs)
+/// of [`CompactSkin::pairs`]; the result is the same). A skin with quantised weights
+/// ([`crate::WeightFormat`]) is run 64 vertices at a time, each piece's weights widened
+/// to floats on the stack first.
 ///
 /// The loop is specialised per influence count and stream set, and comes in the
 /// [`InstructionSet`] families: [`SkinningJob::run`] takes the widest this CPU runs
@@ -123,10 +131,19 @@ impl SkinningJob<'_> {
             });
         }
         self.validate()?;
+        let (weights, quantised) = match self.skin.stored_weights() {
+            StoredWeights::Float32(w) => (w.as_slice(), Quantised::None),
+            StoredWeights::Unorm16(q) => (&[][..], Quantised::Unorm16(q)),
+            StoredWeights::Unorm8(q) => (&[][..], Quantised::Unorm8(q)),
+        };
         let span = Span {
             joints: self.skin.joints(),
-            weights: self.skin.weights(),
+            weights,
+            quantised,
             block_influences: self.skin.block_influences(),
+            hemispheres_agree: set != InstructionSet::Portable
+                && self.palette.method() == SkinningMethod::DualQuaternion
+                && self.palette.hemispheres_agree(self.skin),
             rest_positions: self.rest_positions,
             rest_normals: self.rest_normals.unwrap_or_default(),
             rest_tangents: self.rest_tangents.unwrap_or_default(),
@@ -246,13 +263,54 @@ impl Blend for DualQuat {
     }
 }
 
+/// Quantised explicit weights of a span (its `weights` then are widened by
+/// [`run_dequantised`] before a loop sees them).
+#[derive(Clone, Copy)]
+pub(crate) enum Quantised<'a> {
+    None,
+    Unorm16(&'a [u16]),
+    Unorm8(&'a [u8]),
+}
+
+impl<'a> Quantised<'a> {
+    /// The first `at` weights and the rest.
+    fn split_at(self, at: usize) -> (Self, Self) {
+        match self {
+            Self::None => (Self::None, Self::None),
+            Self::Unorm16(q) => {
+                let (a, b) = q.split_at(at.min(q.len()));
+                (Self::Unorm16(a), Self::Unorm16(b))
+            }
+            Self::Unorm8(q) => {
+                let (a, b) = q.split_at(at.min(q.len()));
+                (Self::Unorm8(a), Self::Unorm8(b))
+            }
+        }
+    }
+
+    /// Writes the weights, widened to floats, to the start of `out` (long enough).
+    fn widen_into(self, out: &mut [f32]) {
+        match self {
+            Self::None => {}
+            Self::Unorm16(q) => out.iter_mut().zip(q).for_each(|(w, &q)| *w = unorm16(q)),
+            Self::Unorm8(q) => out.iter_mut().zip(q).for_each(|(w, &q)| *w = unorm8(q)),
+        }
+    }
+}
+
 /// A contiguous range of vertices: its slice of every stream. Absent optional streams are
 /// empty slices.
 pub(crate) struct Span<'a> {
     pub(crate) joints: &'a [u16],
+    /// The explicit weights as floats (empty while `quantised` holds them).
     pub(crate) weights: &'a [f32],
+    pub(crate) quantised: Quantised<'a>,
     /// [`CompactSkin::block_influences`] of the span, which starts at a block boundary.
     pub(crate) block_influences: &'a [u32],
+    /// For dual quaternions: every pair of joints of a row has real parts with a positive
+    /// dot product ([`SkinningPalette::hemispheres_agree`]), so the sign fix may be left
+    /// out.
+    pub(crate) hemispheres_agree: bool,
     pub(crate) rest_positions: &'a [Vec3],
     pub(crate) rest_normals: &'a [Vec3],
     pub(crate) rest_tangents: &'a [Vec4],
@@ -296,6 +354,7 @@ impl<'a> Span<'a> {
         }
         let (joints_a, joints_b) = cut(self.joints, mid * k);
         let (weights_a, weights_b) = cut(self.weights, mid * (k - 1));
+        let (quantised_a, quantised_b) = self.quantised.split_at(mid * (k - 1));
         let (blocks_a, blocks_b) = cut(self.block_influences, mid / INFLUENCE_BLOCK);
         let (rest_p_a, rest_p_b) = cut(self.rest_positions, mid);
         let (rest_n_a, rest_n_b) = cut(self.rest_normals, mid);
@@ -307,7 +366,9 @@ impl<'a> Span<'a> {
             Span {
                 joints: joints_a,
                 weights: weights_a,
+                quantised: quantised_a,
                 block_influences: blocks_a,
+                hemispheres_agree: self.hemispheres_agree,
                 rest_positions: rest_p_a,
                 rest_normals: rest_n_a,
                 rest_tangents: rest_t_a,
@@ -318,7 +379,9 @@ impl<'a> Span<'a> {
             Span {
                 joints: joints_b,
                 weights: weights_b,
+                quantised: quantised_b,
                 block_influences: blocks_b,
+                hemispheres_agree: self.hemispheres_agree,
                 rest_positions: rest_p_b,
                 rest_normals: rest_n_b,
                 rest_tangents: rest_t_b,
@@ -373,8 +436,40 @@ fn dispatch<B: Blend>(
     let kernel = B::simd_kernel(set, k, normals, tangents)
         .unwrap_or_else(|| portable_kernel::<B>(k, normals, tangents));
     match threading {
-        Threading::Sequential => kernel(palette, k, span),
+        Threading::Sequential => run_dequantised(palette, k, span, kernel),
         Threading::Parallel => run_parallel(palette, k, span, kernel),
+    }
+}
+
+/// Vertices per piece of [`run_dequantised`]: the widened weights of a piece
+/// (≤ 64 × 7 floats, 1.8 KB) stay in the first-level cache.
+const DEQUANTISED_PIECE: usize = 64;
+const _: () = assert!(DEQUANTISED_PIECE.is_multiple_of(INFLUENCE_BLOCK));
+
+/// Runs `kernel` on the span; with quantised weights, piece by piece of
+/// [`DEQUANTISED_PIECE`] vertices, each piece's weights first widened to floats in a
+/// buffer on the stack (the loops then read floats as ever; nothing is allocated).
+fn run_dequantised<B: Blend>(palette: &[B], k: usize, span: Span, kernel: Kernel<B>) {
+    if matches!(span.quantised, Quantised::None) {
+        kernel(palette, k, span);
+        return;
+    }
+    let mut widened = [0.0f32; DEQUANTISED_PIECE * (MAX_QUANTISED_INFLUENCES - 1)];
+    let mut rest = span;
+    while rest.len() > 0 {
+        let (piece, tail) = rest.split_at(DEQUANTISED_PIECE, k);
+        let explicit = piece.len() * (k - 1);
+        piece.quantised.widen_into(&mut widened[..explicit]);
+        kernel(
+            palette,
+            k,
+            Span {
+                weights: &widened[..explicit],
+                quantised: Quantised::None,
+                ..piece
+            },
+        );
+        rest = tail;
     }
 }
 
@@ -393,7 +488,7 @@ fn portable_kernel<B: Blend>(k: usize, normals: bool, tangents: bool) -> Kernel<
 /// empty stream has no chunk): zipping would need one loop per set of present streams.
 fn run_parallel<B: Blend>(palette: &[B], k: usize, span: Span, kernel: Kernel<B>) {
     if span.len() <= PARALLEL_CHUNK {
-        kernel(palette, k, span);
+        run_dequantised(palette, k, span, kernel);
         return;
     }
     let chunks = span.len().div_ceil(PARALLEL_CHUNK);
@@ -450,8 +545,13 @@ mod tests {
         );
         let span = Span {
             joints: skin.joints(),
-            weights: skin.weights(),
+            weights: match skin.stored_weights() {
+                StoredWeights::Float32(w) => w,
+                _ => unreachable!("the tests of this module use float weights"),
+            },
+            quantised: Quantised::None,
             block_influences: skin.block_influences(),
+            hemispheres_agree: false,
             rest_positions: rest,
             rest_normals: rest,
             rest_tangents: tangents,

@@ -1,7 +1,7 @@
 //! The per-frame palette in the forms the skinning loops read.
 
 use crate::dual_quaternion::DualQuat;
-use crate::RuntimeError;
+use crate::{CompactSkin, RuntimeError};
 use glam::{Mat3, Mat4};
 
 /// Largest accepted deviation of a palette matrix's linear part from a rotation,
@@ -118,6 +118,43 @@ impl SkinningPalette {
     pub fn dual_quaternions(&self) -> &[DualQuat] {
         &self.dual_quaternions
     }
+
+    /// Chooses the sign of each dual quaternion (`q̂` and `−q̂` are the same rigid
+    /// transform) so that joints sharing a vertex of `skin` lie in one hemisphere: along
+    /// [`CompactSkin::hemisphere_forest`], `q̂_b ← −q̂_b` when `real(q̂_a) · real(q̂_b) < 0`.
+    /// O(#J); allocates nothing. Call after [`SkinningPalette::update`] for dual
+    /// quaternions, with the skin of the job.
+    ///
+    /// Then the blend's sign fix (Kavan et al. 2007 §4.1: each influence turned into the
+    /// hemisphere of the vertex's first) is the identity for every pair of the skin unless
+    /// the pose closes a loop of pairs the other way, and the vector loops blend without
+    /// it ([`SkinningPalette::hemispheres_agree`] decides per job). The result is the same
+    /// either way: flipping every term's sign with the first's changes neither the
+    /// normalised blend's rotation nor its translation.
+    pub fn align_hemispheres(&mut self, skin: &CompactSkin) {
+        for &(a, b) in skin.hemisphere_forest() {
+            let (a, b) = (usize::from(a), usize::from(b));
+            let reference = self.dual_quaternions[a].real;
+            let q = &mut self.dual_quaternions[b];
+            if q.real.dot(reference) < 0.0 {
+                *q = q.scaled(-1.0);
+            }
+        }
+    }
+
+    /// True when every pair of joints sharing a vertex of `skin`
+    /// ([`CompactSkin::pairs`]) has real parts with a positive dot product, so that
+    /// blending without the sign fix gives the blend with it. O(pairs).
+    pub fn hemispheres_agree(&self, skin: &CompactSkin) -> bool {
+        let quaternions = &self.dual_quaternions;
+        skin.joint_count() == quaternions.len()
+            && skin.pairs().iter().all(|&(a, b)| {
+                quaternions[usize::from(a)]
+                    .real
+                    .dot(quaternions[usize::from(b)].real)
+                    > 0.0
+            })
+    }
 }
 
 /// Rejects a matrix whose linear part `L` has `max |Lᵀ L − I| > RIGID_TOLERANCE` or a
@@ -198,6 +235,9 @@ mod tests {
         }
         let mut palette = SkinningPalette::new(2);
         let scaled = [rigid, Mat4::from_scale(Vec3::splat(2.0))];
+        assert!(palette.hemispheres_agree(
+            &CompactSkin::new(&crate::VertexWeights::from_rows([vec![(0, 1.0)]]), 2, 1).unwrap()
+        ));
         assert!(palette.update(&scaled, SkinningMethod::LinearBlend).is_ok());
         assert_eq!(
             palette.update(&scaled, SkinningMethod::DualQuaternion),
@@ -206,5 +246,50 @@ mod tests {
                 scale: 2.0
             })
         );
+    }
+}
+
+#[cfg(test)]
+mod hemisphere_tests {
+    use super::*;
+    use crate::VertexWeights;
+    use glam::{Quat, Vec3};
+
+    /// Joints 0–1, 1–2 and 0–2 share vertices: aligning along the forest makes the chain
+    /// agree for small turns; three quarter turns about one axis (0°, 120°, 240°) cannot
+    /// all agree (the loop of pairs closes the other way).
+    #[test]
+    fn alignment_makes_pairs_agree_unless_a_loop_closes_the_other_way() {
+        let weights = VertexWeights::from_rows([
+            vec![(0, 0.6), (1, 0.4)],
+            vec![(1, 0.6), (2, 0.4)],
+            vec![(2, 0.6), (0, 0.4)],
+        ]);
+        let skin = CompactSkin::new(&weights, 3, 2).unwrap();
+        let turn = |degrees: f32| Mat4::from_quat(Quat::from_rotation_z(degrees.to_radians()));
+        let mut palette = SkinningPalette::new(3);
+        // Signs as converted: glam may give either hemisphere; flip one on purpose.
+        palette
+            .update(
+                &[turn(0.0), turn(30.0), turn(60.0)],
+                SkinningMethod::DualQuaternion,
+            )
+            .unwrap();
+        palette.dual_quaternions[1] = palette.dual_quaternions[1].scaled(-1.0);
+        assert!(!palette.hemispheres_agree(&skin));
+        palette.align_hemispheres(&skin);
+        assert!(palette.hemispheres_agree(&skin));
+        let p = Vec3::new(1.0, 2.0, 3.0);
+        assert!(palette.dual_quaternions[1]
+            .transform_point(p)
+            .abs_diff_eq(turn(30.0).transform_point3(p), 1e-5));
+        palette
+            .update(
+                &[turn(0.0), turn(120.0), turn(240.0)],
+                SkinningMethod::DualQuaternion,
+            )
+            .unwrap();
+        palette.align_hemispheres(&skin);
+        assert!(!palette.hemispheres_agree(&skin));
     }
 }

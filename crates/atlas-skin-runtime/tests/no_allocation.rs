@@ -1,4 +1,4 @@
-//! A frame allocates nothing: preparing the palette and skinning positions and normals, by
+//! A frame allocates nothing: preparing the palette (with its hemispheres aligned) and skinning positions and normals, by
 //! linear blend and by dual quaternions, with every instruction set this CPU runs, on one
 //! thread. This test binary alone replaces the global allocator by one that counts (the
 //! library and the `atlas-skin` binary use the system's unchanged).
@@ -70,6 +70,7 @@ fn a_frame_allocates_nothing() {
             let mut palette = SkinningPalette::new(JOINTS);
             let mut frame = |pose: &[Mat4]| {
                 palette.update(pose, method).expect("rigid palette");
+                palette.align_hemispheres(&skin);
                 SkinningJob {
                     skin: &skin,
                     palette: &palette,

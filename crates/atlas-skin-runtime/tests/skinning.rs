@@ -7,7 +7,7 @@ use atlas_skin_runtime::reference::{
 };
 use atlas_skin_runtime::{
     CompactSkin, InstructionSet, RuntimeError, SkinningJob, SkinningMethod, SkinningPalette,
-    Threading, VertexWeights,
+    Threading, VertexWeights, WeightFormat,
 };
 use glam::{Mat4, Quat, Vec3, Vec4};
 use proptest::prelude::*;
@@ -28,6 +28,7 @@ fn supported_sets() -> Vec<InstructionSet> {
         .collect()
 }
 
+/// [`run_job_aligned`] with the palette's hemispheres aligned to the skin.
 #[allow(clippy::too_many_arguments)]
 fn run_job(
     set: InstructionSet,
@@ -39,8 +40,26 @@ fn run_job(
     rest_normals: &[Vec3],
     with_tangents: bool,
 ) -> Result<Posed, RuntimeError> {
+    let streams = (rest_positions, rest_normals, with_tangents);
+    run_job_aligned(set, skin, matrices, (method, true), threading, streams)
+}
+
+/// One job; `aligned`: the dual quaternions' hemispheres aligned to the skin
+/// (`SkinningPalette::align_hemispheres`), which lets the vector loops leave out the sign
+/// fix when every pair then agrees.
+fn run_job_aligned(
+    set: InstructionSet,
+    skin: &CompactSkin,
+    matrices: &[Mat4],
+    (method, aligned): (SkinningMethod, bool),
+    threading: Threading,
+    (rest_positions, rest_normals, with_tangents): (&[Vec3], &[Vec3], bool),
+) -> Result<Posed, RuntimeError> {
     let mut palette = SkinningPalette::new(matrices.len());
     palette.update(matrices, method)?;
+    if aligned {
+        palette.align_hemispheres(skin);
+    }
     let rest_tangents: Vec<Vec4> = rest_normals
         .iter()
         .map(|n| n.any_orthonormal_vector().extend(-1.0))
@@ -99,6 +118,15 @@ fn weights_strategy(vertices: usize, joints: u32) -> impl Strategy<Value = Verte
     .prop_map(VertexWeights::from_rows)
 }
 
+/// Every way a skin stores its weights.
+fn formats() -> impl Strategy<Value = WeightFormat> {
+    prop::sample::select(vec![
+        WeightFormat::Float32,
+        WeightFormat::Unorm16,
+        WeightFormat::Unorm8,
+    ])
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
@@ -113,19 +141,20 @@ proptest! {
         points in prop::collection::vec(prop::array::uniform3(-1.0f32..1.0), 300),
         max_influences in 1usize..7,
         parallel in any::<bool>(),
+        format in formats(),
     ) {
         let matrices: Vec<Mat4> = rotations.iter().zip(&translations).map(|(r, t)| rigid(*r, *t)).collect();
         let rest: Vec<Vec3> = points.iter().map(|p| Vec3::from(*p)).collect();
         let normals: Vec<Vec3> = rest.iter().map(|p| p.normalize_or(Vec3::Z)).collect();
-        let skin = CompactSkin::new(&rows, 6, max_influences).unwrap();
+        let skin = CompactSkin::with_format(&rows, 6, max_influences, format).unwrap();
         let reference_weights = skin.to_vertex_weights();
         let threading = if parallel { Threading::Parallel } else { Threading::Sequential };
         let mut expected_p = vec![Vec3::ZERO; rest.len()];
         let mut expected_n = vec![Vec3::ZERO; rest.len()];
         let tolerance = 1e-5 * diagonal(&rest);
         for (tangents, set) in [false, true].into_iter().flat_map(|t| supported_sets().into_iter().map(move |s| (t, s))) {
-            for method in [SkinningMethod::LinearBlend, SkinningMethod::DualQuaternion] {
-                let posed = run_job(set, &skin, &matrices, method, threading, &rest, &normals, tangents).unwrap();
+            for (method, aligned) in [(SkinningMethod::LinearBlend, false), (SkinningMethod::DualQuaternion, false), (SkinningMethod::DualQuaternion, true)] {
+                let posed = run_job_aligned(set, &skin, &matrices, (method, aligned), threading, (&rest, &normals, tangents)).unwrap();
                 match method {
                     SkinningMethod::LinearBlend => {
                         linear_blend_positions(&rest, &reference_weights, &matrices, &mut expected_p);
@@ -136,8 +165,8 @@ proptest! {
                         dual_quaternion_vectors(&normals, &reference_weights, &matrices, &mut expected_n);
                     }
                 }
-                prop_assert!(max_distance(&posed.positions, &expected_p) <= tolerance, "{method:?} {set:?} positions, tangents: {tangents}");
-                prop_assert!(max_distance(&posed.normals, &expected_n) <= 1e-5, "{method:?} {set:?} normals, tangents: {tangents}");
+                prop_assert!(max_distance(&posed.positions, &expected_p) <= tolerance, "{method:?} {set:?} positions, tangents: {tangents}, aligned: {aligned}");
+                prop_assert!(max_distance(&posed.normals, &expected_n) <= 1e-5, "{method:?} {set:?} normals, tangents: {tangents}, aligned: {aligned}");
             }
         }
     }
@@ -148,10 +177,11 @@ proptest! {
         rows in weights_strategy(200, 5),
         points in prop::collection::vec(prop::array::uniform3(-100.0f32..100.0), 200),
         max_influences in 1usize..7,
+        format in formats(),
     ) {
         let rest: Vec<Vec3> = points.iter().map(|p| Vec3::from(*p)).collect();
         let normals: Vec<Vec3> = rest.iter().map(|p| p.normalize_or(Vec3::Z)).collect();
-        let skin = CompactSkin::new(&rows, 5, max_influences).unwrap();
+        let skin = CompactSkin::with_format(&rows, 5, max_influences, format).unwrap();
         for method in [SkinningMethod::LinearBlend, SkinningMethod::DualQuaternion] {
             for (tangents, set) in [false, true].into_iter().flat_map(|t| supported_sets().into_iter().map(move |s| (t, s))) {
                 let posed = run_job(set, &skin, &[Mat4::IDENTITY; 5], method, Threading::Sequential, &rest, &normals, tangents).unwrap();
@@ -340,5 +370,55 @@ fn parallel_run_equals_sequential_run_bit_for_bit() {
         .unwrap();
         assert_eq!(sequential.positions, parallel.positions);
         assert_eq!(sequential.normals, parallel.normals);
+    }
+}
+
+/// Turns of up to 0.3 rad on a skin where every joint shares vertices with every other:
+/// aligned, every pair agrees, so the vector loops blend without the sign fix, and still
+/// match the scalar reference (which fixes signs against each vertex's first influence).
+#[test]
+fn aligned_dual_quaternions_match_the_reference() {
+    use atlas_skin_runtime::random_pose::{random_rotations, SplitMix64};
+    const JOINTS: usize = 6;
+    let mut rng = SplitMix64::new(5);
+    let rest: Vec<Vec3> = (0..400).map(|_| rng.unit_vector()).collect();
+    let normals: Vec<Vec3> = (0..400).map(|_| rng.unit_vector()).collect();
+    let weights = VertexWeights::from_rows((0..rest.len()).map(|v| {
+        (0..1 + v % 4)
+            .map(|i| (((v + 2 * i) % JOINTS) as u32, 0.1 + (i as f32)))
+            .collect::<Vec<_>>()
+    }));
+    let skin = CompactSkin::new(&weights, JOINTS, 4).unwrap();
+    let reference_weights = skin.to_vertex_weights();
+    for seed in 0..4 {
+        let matrices: Vec<Mat4> = random_rotations(JOINTS, 0.3, seed)
+            .into_iter()
+            .map(|q| Mat4::from_rotation_translation(q, rng.unit_vector()))
+            .collect();
+        let mut palette = SkinningPalette::new(JOINTS);
+        palette
+            .update(&matrices, SkinningMethod::DualQuaternion)
+            .unwrap();
+        palette.align_hemispheres(&skin);
+        assert!(palette.hemispheres_agree(&skin), "seed {seed}");
+        let mut expected_p = vec![Vec3::ZERO; rest.len()];
+        let mut expected_n = vec![Vec3::ZERO; rest.len()];
+        dual_quaternion_positions(&rest, &reference_weights, &matrices, &mut expected_p);
+        dual_quaternion_vectors(&normals, &reference_weights, &matrices, &mut expected_n);
+        for set in supported_sets() {
+            let method = (SkinningMethod::DualQuaternion, true);
+            let streams = (rest.as_slice(), normals.as_slice(), false);
+            let posed = run_job_aligned(
+                set,
+                &skin,
+                &matrices,
+                method,
+                Threading::Sequential,
+                streams,
+            )
+            .unwrap();
+            assert!(max_distance(&posed.positions, &expected_p) <= 1e-5 * diagonal(&rest));
+            assert!(max_distance(&posed.normals, &expected_n) <= 1e-5);
+        }
     }
 }

@@ -28,7 +28,7 @@ use atlas_skin_runtime::random_pose::random_rotations;
 use atlas_skin_runtime::skinning_job::PARALLEL_CHUNK;
 use atlas_skin_runtime::{
     CompactSkin, InstructionSet, SkinningJob, SkinningMethod, SkinningPalette, Threading,
-    VertexWeights,
+    VertexWeights, WeightFormat,
 };
 use glam::{Mat4, Vec3};
 use rayon::prelude::*;
@@ -64,6 +64,11 @@ pub struct Args {
     /// The skinning loops: portable, avx2 or avx512 (default: the widest this CPU runs).
     #[arg(long, value_name = "NAME")]
     pub instruction_set: Option<String>,
+    /// How the skin stores its weights: f32, or the normalised integers unorm16 or unorm8
+    /// (fewer bytes per frame, weights rounded to 1.5e-5 or 3.9e-3).
+    #[arg(long, value_name = "FORMAT", default_value = "f32",
+          value_parser = ["f32", "unorm16", "unorm8"])]
+    pub weight_format: String,
     /// Print the figures as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -83,6 +88,8 @@ pub struct BenchReport {
     pub batch: usize,
     /// The skinning loops that ran ([`InstructionSet::name`]).
     pub instruction_set: &'static str,
+    /// How the skin stored its weights (`--weight-format`).
+    pub weight_format: String,
     pub influences: usize,
     pub lbs_vertices_per_second: f64,
     pub dqs_vertices_per_second: f64,
@@ -109,7 +116,9 @@ pub fn run(args: Args) -> Result<()> {
         .as_ref()
         .context("the character has no skin weights")?;
     let count = args.vertices.unwrap_or(posable.rest_positions.len());
-    let mut streams = Streams::replicate(&posable, weights, count)?;
+    let format = WeightFormat::from_name(&args.weight_format)
+        .with_context(|| format!("unknown weight format {:?}", args.weight_format))?;
+    let mut streams = Streams::replicate(&posable, weights, count, format)?;
     let palettes: Vec<Vec<Mat4>> = (0..POSES as u64)
         .map(|seed| {
             posable.palette(&posable.with_rotations(&random_rotations(
@@ -157,6 +166,7 @@ pub fn run(args: Args) -> Result<()> {
         frames: args.frames,
         batch: args.batch,
         instruction_set: set.name(),
+        weight_format: args.weight_format.clone(),
         influences: streams.skin.influences(),
         lbs_vertices_per_second: lbs_rate,
         dqs_vertices_per_second: dqs_rate,
@@ -175,8 +185,8 @@ pub fn run(args: Args) -> Result<()> {
 
 fn print_report(r: &BenchReport) {
     println!(
-        "{} vertices, {} influences, {} thread(s), {} loops, {} samples of {} frame(s) per method",
-        r.vertices, r.influences, r.threads, r.instruction_set, r.frames, r.batch
+        "{} vertices, {} influences ({} weights), {} thread(s), {} loops, {} samples of {} frame(s) per method",
+        r.vertices, r.influences, r.weight_format, r.threads, r.instruction_set, r.frames, r.batch
     );
     println!(
         "linear blend:    {:8.1} M vertices/s ({:.0}% of copy bandwidth)",
@@ -210,14 +220,19 @@ struct Streams {
 impl Streams {
     /// Vertex v is the character's vertex `v mod #V` (the mesh tiled in place: the same
     /// work per vertex, a working set that grows with `count`).
-    fn replicate(posable: &Posable, weights: &VertexWeights, count: usize) -> Result<Self> {
+    fn replicate(
+        posable: &Posable,
+        weights: &VertexWeights,
+        count: usize,
+        format: WeightFormat,
+    ) -> Result<Self> {
         let original = posable.rest_positions.len();
         let tile = |v: usize| v % original;
         let rows =
             VertexWeights::from_rows((0..count).map(|v| weights.row(tile(v)).collect::<Vec<_>>()));
-        let skin = CompactSkin::new(&rows, posable.skeleton.len(), POSE_INFLUENCES)
+        let skin = CompactSkin::with_format(&rows, posable.skeleton.len(), POSE_INFLUENCES, format)
             .context("invalid skin weights")?;
-        let copy_len = (bytes_per_vertex(skin.influences()) * count / 2).div_ceil(8);
+        let copy_len = (bytes_per_vertex(&skin) * count / 2).div_ceil(8);
         Ok(Self {
             skin,
             copy_source: vec![1; copy_len],
@@ -232,7 +247,7 @@ impl Streams {
     }
 
     fn bytes_per_vertex(&self) -> usize {
-        bytes_per_vertex(self.skin.influences())
+        bytes_per_vertex(&self.skin)
     }
 
     /// Bytes a copy pass reads plus writes: about those of a frame.
@@ -255,6 +270,9 @@ impl Streams {
             palette
                 .update(pose, method)
                 .context("cannot skin the benchmark pose")?;
+            if method == SkinningMethod::DualQuaternion {
+                palette.align_hemispheres(&self.skin);
+            }
             SkinningJob {
                 skin: &self.skin,
                 palette,
@@ -286,11 +304,12 @@ impl Streams {
     }
 }
 
-/// Bytes a vertex with `k` influences reads (position, normal, k u16 joints, k − 1 f32
-/// weights) and writes (position, normal).
-fn bytes_per_vertex(k: usize) -> usize {
+/// Bytes a vertex with k influences reads (position, normal, k u16 joints, k − 1
+/// weights of the skin's format) and writes (position, normal).
+fn bytes_per_vertex(skin: &CompactSkin) -> usize {
     let vec3 = std::mem::size_of::<Vec3>();
-    2 * vec3 + 2 * k + 4 * (k - 1) + 2 * vec3
+    let k = skin.influences();
+    2 * vec3 + 2 * k + skin.weight_format().bytes() * (k - 1) + 2 * vec3
 }
 
 /// Median seconds of a frame of each method and of a copy pass.
