@@ -6,7 +6,7 @@
 //! none (an eye, a hat, a belt, a shell whose joints were bound to another piece). Each
 //! piece of the second kind is treated as a whole, by the geometry, with no flag. The
 //! bones a piece *holds* are those that run inside it, for at least half their length
-//! when some do ([`held_bones`]: a boot holds the foot's bones, a helmet the head's, an
+//! when some do (`held_bones`: a boot holds the foot's bones, a helmet the head's, an
 //! upper-arm shell the upper arm's); when it holds some, only they are its candidates,
 //! otherwise every bone is (an eye, a hair card). With J(p) the joint of the candidate
 //! bone segment nearest to p and d_B(p) the distance to it
@@ -27,7 +27,7 @@
 //! 4. **joints** otherwise: the piece spans a joint with no body beneath and no cut of its
 //!    own (an arm modelled apart from the torso, an open sleeve) and bends at the boundary
 //!    planes of the joints it holds, or, holding none, of the joints of its vertices'
-//!    nearest bones ([`HeldJoints`]), with the transition of §4 across each plane: for a
+//!    nearest bones (`HeldJoints`), with the transition of §4 across each plane: for a
 //!    vertex p whose nearest of those bones is J's, the weight flows from the root of J's
 //!    chain among those joints down to J, each joint c on the way passing on the share
 //!    s_c(p) = β(clamp((w_c + n_c·(p − o_c)) / (2 w_c), 0, 1)) of its boundary (plane
