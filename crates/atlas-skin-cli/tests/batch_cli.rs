@@ -63,19 +63,20 @@ fn is_complete_glb(path: &Path) -> bool {
         && u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize == bytes.len()
 }
 
-/// The Khronos glTF-Validator finds in each output no more errors and warnings of any code
-/// than in its input (5 bench inputs carry zero-length normals, an error the writer keeps;
-/// information messages such as unused objects are not counted), and no error at all in
-/// the outputs of the inputs without one.
+/// The Khronos glTF-Validator finds no error in any output (5 bench inputs carry
+/// zero-length normals, which the writer repairs) and no warning the input did not have
+/// (information messages such as unused objects are not counted).
 fn assert_no_new_validator_issues(inputs: &[PathBuf], outputs: &[PathBuf]) {
     let input_reports = node_check("validate.mjs", inputs);
     let output_reports = node_check("validate.mjs", outputs);
-    let mut clean = 0;
+    let mut inputs_with_errors = 0;
     for (input, output) in input_reports.iter().zip(&output_reports) {
+        assert_eq!(output["errors"], 0, "{output}");
+        inputs_with_errors += usize::from(input["errors"] != 0);
         let codes = output["codes"].as_object().expect("codes");
         for (code, count) in codes
             .iter()
-            .filter(|(code, _)| code.starts_with("error:") || code.starts_with("warning:"))
+            .filter(|(code, _)| code.starts_with("warning:"))
         {
             let allowed = input["codes"]
                 .get(code)
@@ -86,12 +87,11 @@ fn assert_no_new_validator_issues(inputs: &[PathBuf], outputs: &[PathBuf]) {
                 "{code}: {count} in the output, {allowed} in the input: {output}"
             );
         }
-        if input["errors"] == 0 {
-            assert_eq!(output["errors"], 0, "{output}");
-            clean += 1;
-        }
     }
-    assert!(clean >= 60, "only {clean} inputs without a validator error");
+    assert!(
+        inputs_with_errors >= 5,
+        "the bench's inputs with invalid normals are repaired: {inputs_with_errors}"
+    );
 }
 
 #[test]

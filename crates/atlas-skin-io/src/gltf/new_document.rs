@@ -164,7 +164,7 @@ fn material_groups(
 /// Smooth vertex normals: `n_v = normalize(Σ_{t ∋ v} (p_b − p_a) × (p_c − p_a))`, the
 /// area-weighted mean of the incident face normals; +Y where that sum vanishes (isolated or
 /// degenerate fans), since glTF requires unit normals.
-fn smooth_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
+pub(crate) fn smooth_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
     let mut sums = vec![Vec3::ZERO; positions.len()];
     for &[a, b, c] in triangles {
         let (pa, pb, pc) = (

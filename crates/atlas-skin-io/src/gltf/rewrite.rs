@@ -3,6 +3,7 @@
 use super::animation::append_clips;
 use super::bindings::node_positions;
 use super::builder::{component_bounds, GlbBuilder};
+use super::new_document::smooth_normals;
 use super::prune::{drop_orphans, References};
 use super::write::{
     merge_asset_extras, pack_weights, push_inverse_binds, push_weight_accessors, WriteOptions,
@@ -89,6 +90,7 @@ pub(crate) fn rewrite_document(
     }
     replace_weight_attributes(builder.json_mut(), &new_sets);
     set_position_bounds(builder.json_mut(), character, source);
+    let mut builder = repair_normals(builder, character, source);
     if let (true, Some(skeleton), Some(skin)) = (
         source.inverse_binds_cleaned,
         character.skeleton.as_ref(),
@@ -150,14 +152,11 @@ fn set_position_bounds(json: &mut Map<String, Value>, character: &Character, sou
     let Some(Value::Array(accessors)) = json.get_mut("accessors") else {
         return;
     };
-    // Only the first skin's primitives hold the stored positions: those of other skins and
-    // rigid meshes were moved into its bind space when read, and keep their own bounds.
-    let stored_as_read = |p: &&super::PrimitiveSource| match (p.binding, source.skin) {
-        (Binding::Skin(skin), Some(first)) => skin == first,
-        (Binding::Unskinned, _) => true,
-        _ => false,
-    };
-    for primitive in source.primitives.iter().filter(stored_as_read) {
+    for primitive in source
+        .primitives
+        .iter()
+        .filter(|p| stored_as_read(p, source))
+    {
         let Some(Value::Object(accessor)) = accessors.get_mut(primitive.position_accessor) else {
             continue;
         };
@@ -178,6 +177,128 @@ fn set_position_bounds(json: &mut Map<String, Value>, character: &Character, sou
             }
         }
     }
+}
+
+/// Whether `primitive`'s vertices are stored in `Character::mesh` as the file has them:
+/// only the first skin's primitives (and unskinned ones) are; those of other skins and
+/// rigid meshes were moved into its bind space when read, and keep their own data.
+fn stored_as_read(primitive: &super::PrimitiveSource, source: &GltfSource) -> bool {
+    match (primitive.binding, source.skin) {
+        (Binding::Skin(skin), Some(first)) => skin == first,
+        (Binding::Unskinned, _) => true,
+        _ => false,
+    }
+}
+
+/// Makes every NORMAL of the primitives stored as read unit length, as glTF 2.0 requires
+/// (§3.7.2.1): a vector of another length is normalised, a zero or non-finite one replaced
+/// by the smooth normal of its vertex ([`smooth_normals`]). The copied bytes are repaired
+/// in place and the accessor's declared `min`/`max` follow; a sparse or non-float NORMAL
+/// accessor is left as it is.
+fn repair_normals(builder: GlbBuilder, character: &Character, source: &GltfSource) -> GlbBuilder {
+    let (mut json, mut bin) = builder.into_parts();
+    let mut smooth: Option<Vec<glam::Vec3>> = None;
+    for primitive in source
+        .primitives
+        .iter()
+        .filter(|p| stored_as_read(p, source))
+    {
+        let Some((accessor, offset, stride, count)) = normal_layout(&json, primitive) else {
+            continue;
+        };
+        if count != primitive.vertices.len() || count == 0 {
+            continue;
+        }
+        let Some(end) = offset.checked_add((count - 1) * stride + 12) else {
+            continue;
+        };
+        if end > bin.len() {
+            continue;
+        }
+        let mut values = Vec::with_capacity(3 * count);
+        let mut repaired_any = false;
+        for k in 0..count {
+            let at = offset + k * stride;
+            let read = |i: usize| {
+                let bytes: [u8; 4] = bin[at + 4 * i..at + 4 * i + 4].try_into().unwrap_or([0; 4]);
+                f32::from_le_bytes(bytes)
+            };
+            let n = glam::Vec3::new(read(0), read(1), read(2));
+            let length = n.length();
+            if (length - 1.0).abs() <= UNIT_TOLERANCE {
+                values.extend_from_slice(&n.to_array());
+                continue;
+            }
+            repaired_any = true;
+            let repaired = if length.is_finite() && length > 0.0 {
+                n / length
+            } else {
+                smooth.get_or_insert_with(|| {
+                    smooth_normals(&character.mesh.positions, &character.mesh.triangles)
+                })[primitive.vertices.start + k]
+            };
+            for (i, value) in repaired.to_array().iter().enumerate() {
+                bin[at + 4 * i..at + 4 * i + 4].copy_from_slice(&value.to_le_bytes());
+            }
+            values.extend_from_slice(&repaired.to_array());
+        }
+        // Bounds the accessor declares follow its repaired values.
+        let object = json
+            .get_mut("accessors")
+            .and_then(|a| a.get_mut(accessor))
+            .and_then(Value::as_object_mut);
+        if let (true, Some(object)) = (repaired_any, object) {
+            let (min, max) = component_bounds(&values, 3);
+            for (key, bound) in [("min", min), ("max", max)] {
+                if object.contains_key(key) {
+                    object.insert(key.into(), json!(bound));
+                }
+            }
+        }
+    }
+    GlbBuilder::from_parts(json, bin)
+}
+
+/// How far from 1 a normal's length may be before [`repair_normals`] rescales it (the
+/// Khronos validator allows 0.0005).
+const UNIT_TOLERANCE: f32 = 1e-4;
+
+/// `primitive`'s NORMAL accessor, its byte offset in the output buffer, stride and count,
+/// when it is a plain (not sparse) float VEC3 accessor on a bufferView.
+fn normal_layout(
+    json: &Map<String, Value>,
+    primitive: &super::PrimitiveSource,
+) -> Option<(usize, usize, usize, usize)> {
+    let index = json
+        .get("meshes")?
+        .get(primitive.mesh)?
+        .get("primitives")?
+        .get(primitive.primitive)?
+        .get("attributes")?
+        .get("NORMAL")?
+        .as_u64()? as usize;
+    let accessor = json.get("accessors")?.get(index)?;
+    if accessor.get("componentType")?.as_u64()? != FLOAT
+        || accessor.get("type")?.as_str()? != "VEC3"
+        || accessor.get("sparse").is_some()
+    {
+        return None;
+    }
+    let view = json
+        .get("bufferViews")?
+        .get(accessor.get("bufferView")?.as_u64()? as usize)?;
+    let offset = |v: &Value| v.get("byteOffset").and_then(Value::as_u64).unwrap_or(0) as usize;
+    let stride = view
+        .get("byteStride")
+        .and_then(Value::as_u64)
+        .map_or(12, |s| s as usize);
+    let count = accessor.get("count")?.as_u64()? as usize;
+    Some((
+        index,
+        offset(view) + offset(accessor),
+        stride.max(12),
+        count,
+    ))
 }
 
 /// True when `value` is an array of the numbers `expected` (as float32: `1` and `1.0`
