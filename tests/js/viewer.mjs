@@ -8,11 +8,14 @@
 // weight heat map and the animation time change the pixels, that the LBS/DQS switch switches
 // (checks.dqs_changed_fraction: how much of the picture it changed), that a hovered joint
 // shows its name and a clicked one is selected, and that dragging a joint poses it
-// (checks.drag_*, see dragJoint). checks.skinning_probe holds GPU-skinned positions (LBS and
-// DQS) of the posed model with the weights and palette that made them. Saves screenshots
-// SCREENSHOT_PREFIX-{regions,weights,pose-lbs,pose-dqs}.png and prints one JSON
-// object: { failures: [...], checks: {...}, screenshots: [...] }; checks.half_time_poses
-// holds, per animation, the animated node values at half its duration.
+// (checks.drag_*, see dragJoint); when the report gives every vertex's piece treatment, that
+// the pieces view changes the colours, shows a legend (checks.pieces_legend: "name count"
+// per treatment) and switches back. checks.skinning_probe holds GPU-skinned positions (LBS
+// and DQS) of the posed model with the weights and palette that made them. Saves
+// screenshots SCREENSHOT_PREFIX-{regions,weights,pieces (when offered),pose-lbs,pose-dqs}.png
+// and prints one JSON object: { failures: [...], checks: {...}, screenshots: [...] };
+// checks.half_time_poses holds, per animation, the animated node values at half its
+// duration.
 import { chromium } from 'playwright-core';
 import { mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
@@ -178,6 +181,24 @@ try {
   if (checks.heat_map_changed_fraction < 0.005) failures.push('the weight heat map did not change the picture');
   await shoot('weights');
   await page.check('#colour-regions');
+
+  // The pieces view, offered when the report gives every vertex's treatment: other colours
+  // and a legend of the treatments present; back on the regions, the picture is as before.
+  checks.pieces_offered = await page.locator('#colour-pieces').isVisible();
+  if (checks.pieces_offered) {
+    const regions = await thumbnail(page);
+    await page.check('#colour-pieces');
+    checks.pieces_changed_fraction = changed(regions, await thumbnail(page));
+    checks.pieces_legend = await page.locator('#pieces-legend .treatment').allTextContents();
+    const legendShown = await page.locator('#pieces-legend').isVisible();
+    await shoot('pieces');
+    await page.check('#colour-regions');
+    checks.pieces_back_changed_fraction = changed(regions, await thumbnail(page));
+    if (checks.pieces_changed_fraction < 0.005) failures.push('the pieces view did not change the picture');
+    if (!checks.pieces_legend.length || !legendShown) failures.push('the pieces view shows no legend');
+    if (await page.locator('#pieces-legend').isVisible()) failures.push('the legend of the pieces stays in the regions view');
+    if (checks.pieces_back_changed_fraction > 0) failures.push('back from the pieces view, the regions did not come back');
+  }
 
   await page.locator('#rot-x').fill('90');
   await page.locator('#rot-z').fill('45');

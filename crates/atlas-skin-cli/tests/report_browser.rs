@@ -1,13 +1,13 @@
 //! The HTML report in Debian's headless Chromium (tests/js/viewer.mjs with playwright-core):
 //! no console error, no network request, a picture that is not blank and that changes with a
-//! joint slider, the heat map and the animation time; the LBS/DQS switch; GPU skinning equal
-//! to the runtime's reference; dragging a joint to pose it; on the demo character and
-//! MakeHuman skinned by `atlas-skin skin --html`, on glTF files as they are, and with a BVH
-//! motion.
+//! joint slider, the heat map, the pieces view and the animation time; the LBS/DQS switch;
+//! GPU skinning equal to the runtime's reference; dragging a joint to pose it; on the demo
+//! character, a benchmark character in pieces and MakeHuman skinned by `atlas-skin skin
+//! --html`, on glTF files as they are, and with a BVH motion.
 
 mod support;
 
-use atlas_skin_corpus::{motion_path, node_json, CESIUMMAN, MAKEHUMAN, RIGGEDFIGURE};
+use atlas_skin_corpus::{data_file, motion_path, node_json, CESIUMMAN, MAKEHUMAN, RIGGEDFIGURE};
 use atlas_skin_runtime::{reference, VertexWeights};
 use glam::{Mat4, Vec3};
 use std::ffi::{OsStr, OsString};
@@ -39,8 +39,67 @@ fn drive(name: &str, html: &Path) -> serde_json::Value {
         serde_json::json!([]),
         "{name}: {result:#}"
     );
-    assert_eq!(result["screenshots"].as_array().map(Vec::len), Some(4));
+    // regions, weights, pose-lbs, pose-dqs, and pieces when the view offers it.
+    let pieces = usize::from(result["checks"]["pieces_offered"] == true);
+    assert_eq!(
+        result["screenshots"].as_array().map(Vec::len),
+        Some(4 + pieces)
+    );
     result["checks"].clone()
+}
+
+/// Skins `input` with `atlas-skin skin --report --html` into the test output folder as
+/// NAME.glb, NAME.json and NAME.html; returns the report and the page's path.
+fn skin_with_report(name: &str, input: Option<&Path>) -> (serde_json::Value, PathBuf) {
+    let dir = output_dir();
+    let [glb, json, html] = ["glb", "json", "html"].map(|e| dir.join(format!("{name}.{e}")));
+    let mut args: Vec<&OsStr> = vec!["skin".as_ref()];
+    args.extend(input.map(Path::as_os_str));
+    args.extend([
+        "-o".as_ref(),
+        glb.as_os_str(),
+        "--report".as_ref(),
+        json.as_os_str(),
+        "--html".as_ref(),
+        html.as_os_str(),
+    ]);
+    atlas_skin(&args);
+    let report = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    (report, html)
+}
+
+/// The name of the treatment of every stored vertex in the report's `pieces`, with the
+/// number of vertices of each.
+fn stored_treatments(report: &serde_json::Value) -> Vec<(String, usize)> {
+    let pieces = &report["pieces"];
+    let names = pieces["treatments"].as_array().expect("treatments");
+    let mut counts = vec![0; names.len()];
+    for k in pieces["vertex_treatments"]
+        .as_array()
+        .expect("vertex treatments")
+    {
+        counts[k.as_u64().expect("an index") as usize] += 1;
+    }
+    names
+        .iter()
+        .zip(counts)
+        .filter(|&(_, count)| count > 0)
+        .map(|(name, count)| (name.as_str().unwrap().to_string(), count))
+        .collect()
+}
+
+/// The pieces view's legend ("name count" per treatment) lists the treatments of the
+/// report's stored vertices, in its order, with their counts.
+fn assert_legend_matches_report(checks: &serde_json::Value, report: &serde_json::Value) {
+    let legend: Vec<String> = stored_treatments(report)
+        .iter()
+        .map(|(name, count)| format!("{name} {count}"))
+        .collect();
+    assert_eq!(
+        checks["pieces_legend"],
+        serde_json::json!(legend),
+        "{checks:#}"
+    );
 }
 
 /// Writes the report of `glb` (with `report_json` if given) with `atlas-skin report` and
@@ -183,6 +242,10 @@ fn cesiumman_with_a_report_shows_cuts_tables_and_warnings() {
     });
     let checks = check_in_browser("cesiumman_report", &CESIUMMAN.input_path(), Some(&report));
     assert_eq!(checks["curve_segments"], 16 + 48);
+    assert_eq!(
+        checks["pieces_offered"], false,
+        "no treatments in this report"
+    );
     // Joints, regions, timings and counts; each with a header row.
     assert_eq!(checks["report_tables"], 4);
     assert_eq!(checks["report_rows"], 3 + 3 + 3 + 2);
@@ -298,23 +361,24 @@ fn animations_are_sampled_linear_step_cubic_and_slerp() {
 
 #[test]
 fn the_demo_character_skinned_by_the_project_shows_its_cuts_and_plays_a_bvh_motion() {
-    let dir = output_dir();
-    let [glb, json, html] = ["demo.glb", "demo.json", "demo.html"].map(|f| dir.join(f));
-    atlas_skin(&[
-        "skin".as_ref(),
-        "-o".as_ref(),
-        glb.as_os_str(),
-        "--report".as_ref(),
-        json.as_os_str(),
-        "--html".as_ref(),
-        html.as_os_str(),
-    ]);
+    let (report, html) = skin_with_report("demo", None);
     let checks = drive("demo", &html);
     assert!(checks["curve_segments"].as_u64() > Some(0), "{checks:#}");
     assert_eq!(checks["report_tables"], 4);
     assert_gpu_skinning_matches_reference(&checks);
     assert_dragging_a_joint_poses_it(&checks);
+    // One piece, decomposed: the pieces view has one colour.
+    assert_eq!(
+        stored_treatments(&report),
+        [(
+            "body".to_string(),
+            report["counts"]["vertices"].as_u64().unwrap() as usize
+        )]
+    );
+    assert_legend_matches_report(&checks, &report);
 
+    let dir = output_dir();
+    let [glb, json] = ["demo.glb", "demo.json"].map(|f| dir.join(f));
     let walk = motion_path("walk.bvh");
     let animated = dir.join("demo_walk.html");
     atlas_skin(&[
@@ -329,6 +393,40 @@ fn the_demo_character_skinned_by_the_project_shows_its_cuts_and_plays_a_bvh_moti
     ]);
     let checks = drive("demo_walk", &animated);
     assert_eq!(checks["animations"], 1, "{checks:#}");
+}
+
+/// A benchmark character in 23 pieces (rignet-val/10563: today body pieces with 96
+/// fallback vertices, attached, rigid and bent pieces): every stored vertex has a
+/// treatment, the treatments present are those of the report's pieces, the fallback's
+/// among them exactly when the report counts fallback vertices; the pieces view shows them.
+#[test]
+fn a_character_in_pieces_shows_each_piece_treatment_in_its_colour() {
+    let input = data_file("bench/rignet-val/10563.glb");
+    let (report, html) = skin_with_report("pieces_10563", Some(&input));
+    let counts = &report["counts"];
+    let vertex_treatments = report["pieces"]["vertex_treatments"].as_array().unwrap();
+    assert_eq!(
+        Some(vertex_treatments.len() as u64),
+        counts["vertices"].as_u64()
+    );
+    let present: Vec<String> = stored_treatments(&report)
+        .into_iter()
+        .map(|(name, _)| name)
+        .collect();
+    let by_treatment = report["pieces"]["by_treatment"].as_object().unwrap();
+    let mut expected: Vec<&str> = ["body", "attached", "rigid", "joints"]
+        .into_iter()
+        .filter(|name| by_treatment.contains_key(*name))
+        .collect();
+    if counts["fallback_weighted_vertices"].as_u64() > Some(0) {
+        expected.push("fallback");
+    }
+    assert_eq!(present, expected, "{:#}", report["pieces"]["by_treatment"]);
+    assert!(present.len() >= 3, "a character in pieces: {present:?}");
+
+    let checks = drive("pieces_10563", &html);
+    assert_eq!(checks["pieces_offered"], true);
+    assert_legend_matches_report(&checks, &report);
 }
 
 #[test]

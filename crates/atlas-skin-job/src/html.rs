@@ -7,8 +7,11 @@
 //! of `[x, y, z]` in the glb's bind space, or as `point`, `normal` and `diameter`, drawn as a
 //! circle), `decomposition.regions[]` (`joint`, `joints`: names; a vertex takes the region of
 //! its dominant joint), `decomposition.vertex_regions` (a region index per vertex of the
-//! skinned mesh, glb order; overrides the dominant joint), `timings_ms` (stage → ms),
-//! `warnings` (strings), `counts` and any other top-level scalar.
+//! skinned mesh, glb order; overrides the dominant joint), `pieces.treatments` (names of
+//! treatments) with `pieces.vertex_treatments` (an index into them per vertex of the
+//! skinned mesh, glb order; with both, the view offers the colour mode "pieces", a fixed
+//! colour per treatment name), `timings_ms` (stage → ms), `warnings` (strings), `counts`
+//! and any other top-level scalar.
 
 use atlas_skin_io::{IoError, OutputPlan};
 use base64::Engine;

@@ -4,8 +4,7 @@
 
 use atlas_skin::pipeline::Skinned;
 use atlas_skin::weights::pieces::PieceTreatment;
-use atlas_skin::weights::WeightCounts;
-use atlas_skin::{BoundaryKind, Decomposition};
+use atlas_skin::BoundaryKind;
 use serde_json::{json, Map, Value};
 
 /// Wall time of each stage of the method, in milliseconds, keyed by stage name.
@@ -20,7 +19,8 @@ pub fn stage_timings(skinned: &Skinned) -> Map<String, Value> {
 
 /// The JSON report: `decomposition` (the decomposition's own report, each joint with its
 /// `overlap_width` and cut `curve`, and the region of every stored vertex),
-/// `timings_ms`, `counts`, `warnings`.
+/// `timings_ms`, `counts`, `pieces` (how each piece and each stored vertex was weighted, see
+/// [`TREATMENTS`]), `warnings`.
 ///
 /// - `input`: the character's name (its path, as displayed).
 /// - `input_warnings`: what the reader noticed, listed before the method's warnings.
@@ -110,23 +110,41 @@ pub fn skin_report(
             "duplicate_faces": counts.duplicate_faces,
             "inside_out_pieces": counts.inside_out_pieces,
         },
-        "pieces": pieces_report(decomposition, weight_counts),
+        "pieces": pieces_report(skinned),
         "warnings": warnings,
     })
 }
 
-/// How the pieces were weighted: per treatment the number of pieces and vertices, and
-/// every piece that was not decomposed (`attached`, `rigid` with its joint, `joints`).
-fn pieces_report(decomposition: &Decomposition, counts: &WeightCounts) -> Value {
+/// The treatments of the report's `pieces.treatments`, in that order: a vertex's piece was
+/// decomposed (`body`), attached to the body surface, bound rigidly to one joint, bent at
+/// its joints ([`PieceTreatment`]), or the vertex was weighted by a fallback (`fallback`: a
+/// vertex of a body piece no region with joints reaches, or a stored vertex no triangle
+/// uses; the warnings say how many of each).
+pub const TREATMENTS: [&str; 5] = ["body", "attached", "rigid", "joints", "fallback"];
+/// Index of `fallback` in [`TREATMENTS`].
+const FALLBACK: usize = 4;
+
+/// Index in [`TREATMENTS`] of a piece's treatment.
+fn treatment_index(treatment: PieceTreatment) -> usize {
+    match treatment {
+        PieceTreatment::Body => 0,
+        PieceTreatment::Attached => 1,
+        PieceTreatment::Rigid(_) => 2,
+        PieceTreatment::Joints => 3,
+    }
+}
+
+/// How the pieces were weighted: per treatment the number of pieces and vertices
+/// (`by_treatment`), every piece that was not decomposed (`not_decomposed`: `attached`,
+/// `rigid` with its joint, `joints`), and the treatment of every stored vertex
+/// (`vertex_treatments`: an index into `treatments`, [`TREATMENTS`]).
+fn pieces_report(skinned: &Skinned) -> Value {
+    let decomposition = &skinned.decomposition;
+    let counts = &skinned.counts.weights;
     let mut summary = serde_json::Map::new();
     let mut loose = Vec::new();
     for piece in &counts.pieces {
-        let (name, joint) = match piece.treatment {
-            PieceTreatment::Body => ("body", None),
-            PieceTreatment::Attached => ("attached", None),
-            PieceTreatment::Rigid(j) => ("rigid", Some(j)),
-            PieceTreatment::Joints => ("joints", None),
-        };
+        let name = TREATMENTS[treatment_index(piece.treatment)];
         let entry = summary
             .entry(name)
             .or_insert_with(|| json!({"pieces": 0, "vertices": 0, "fallback_vertices": 0}));
@@ -138,12 +156,95 @@ fn pieces_report(decomposition: &Decomposition, counts: &WeightCounts) -> Value 
             entry[key] = json!(entry[key].as_u64().unwrap_or(0) + add as u64);
         }
         if piece.treatment != PieceTreatment::Body {
-            loose.push(json!({
-                "treatment": name,
-                "joint": joint.map(|j| decomposition.joints[j as usize].name.clone()),
-                "vertices": piece.vertices,
-            }));
+            let joint = match piece.treatment {
+                PieceTreatment::Rigid(j) => Some(decomposition.joints[j as usize].name.clone()),
+                _ => None,
+            };
+            loose.push(json!({"treatment": name, "joint": joint, "vertices": piece.vertices}));
         }
     }
-    json!({"by_treatment": summary, "not_decomposed": loose})
+    json!({
+        "by_treatment": summary,
+        "not_decomposed": loose,
+        "treatments": TREATMENTS,
+        "vertex_treatments": vertex_treatments(skinned),
+    })
+}
+
+/// The index in [`TREATMENTS`] of every stored vertex: `fallback` when the fallback
+/// weighted its surface vertex or no triangle uses it, else its piece's treatment (the piece
+/// of the split surface that holds its welded vertex).
+fn vertex_treatments(skinned: &Skinned) -> Vec<usize> {
+    let d = &skinned.decomposition;
+    let counts = &skinned.counts.weights;
+    let (piece_of, _) = d.topology.vertex_components(&d.surface);
+    let mut of_surface: Vec<usize> = piece_of
+        .iter()
+        .map(|&c| treatment_index(counts.pieces[c as usize].treatment))
+        .collect();
+    for &v in &counts.from_surface_vertices {
+        of_surface[v as usize] = FALLBACK;
+    }
+    skinned
+        .welded_of_stored
+        .iter()
+        .map(|&w| of_surface.get(w as usize).copied().unwrap_or(FALLBACK))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use atlas_skin::fixtures::demo::demo_character;
+    use atlas_skin::fixtures::pieces::demo_in_pieces;
+    use atlas_skin::fixtures::shapes::icosphere;
+    use atlas_skin::pipeline::{skin, SkinInput, SkinParams};
+    use glam::Vec3;
+
+    /// Grid step of the demo for these tests: coarse, so that the test is quick.
+    const STEP: f64 = 0.02;
+
+    /// The demo in 99 pieces ([`demo_in_pieces`]) with one more stored vertex that no
+    /// triangle uses: each stored vertex gets the treatment of its piece; the eyeballs (the
+    /// first pieces after the demo) are rigid, the body decomposed, the unused vertex a
+    /// fallback; per loose treatment as many stored vertices as the pieces have.
+    #[test]
+    fn every_stored_vertex_gets_the_treatment_of_its_piece() {
+        let mut character = demo_in_pieces(STEP);
+        character.positions.push(Vec3::new(0.0, 1.0, 0.5));
+        let (positions, triangles) = (&character.positions, &character.triangles);
+        let skeleton = &character.skeleton;
+        let input = SkinInput {
+            positions,
+            triangles,
+            skeleton,
+            end_joints: &[],
+        };
+        let skinned = skin(input, &SkinParams::default(), &mut |_| {}).expect("skinned");
+        let report = skin_report("pieces", &[], &skinned, Map::new());
+        let pieces = &report["pieces"];
+        assert_eq!(pieces["treatments"], json!(TREATMENTS));
+        let names: Vec<&str> = pieces["vertex_treatments"]
+            .as_array()
+            .expect("vertex_treatments")
+            .iter()
+            .map(|k| TREATMENTS[k.as_u64().expect("an index") as usize])
+            .collect();
+        assert_eq!(names.len(), character.positions.len());
+
+        let body = demo_character(STEP).positions.len();
+        let eyes = 2 * icosphere(0.02, 2).positions.len();
+        assert!(names[..body].iter().all(|&n| n == "body"));
+        assert!(names[body..body + eyes].iter().all(|&n| n == "rigid"));
+        assert_eq!(names.last(), Some(&"fallback"));
+        assert_eq!(names.iter().filter(|&&n| n == "fallback").count(), 1);
+        for name in ["attached", "rigid", "joints"] {
+            let stored = names.iter().filter(|&&n| n == name).count();
+            let expected = pieces["by_treatment"][name]["vertices"]
+                .as_u64()
+                .unwrap_or(0);
+            assert_eq!(stored as u64, expected, "{name}");
+        }
+        assert!(pieces["by_treatment"]["attached"]["vertices"].as_u64() > Some(0));
+    }
 }

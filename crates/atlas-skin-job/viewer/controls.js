@@ -34,14 +34,27 @@ function bindJointControls(viewer) {
   });
 }
 
-// Regions or one joint's weights, LBS or DQS, and whether the skeleton and boundaries show.
+// Regions, one joint's weights or piece treatments (offered when the report has them, with
+// their legend while shown), LBS or DQS, and whether the skeleton and boundaries show.
 function bindViewOptions(viewer) {
   const { state } = viewer;
-  for (const [id, key, value] of [['colour-regions', 'heat', false], ['colour-weights', 'heat', true], ['method-lbs', 'dqs', false], ['method-dqs', 'dqs', true]]) {
+  const modes = [
+    ['colour-regions', { heat: false, pieces: false }],
+    ['colour-weights', { heat: true, pieces: false }],
+    ['colour-pieces', { heat: false, pieces: true }],
+    ['method-lbs', { dqs: false }],
+    ['method-dqs', { dqs: true }],
+  ];
+  for (const [id, values] of modes) {
     $(id).addEventListener('change', () => {
-      state[key] = value;
+      Object.assign(state, values);
+      $('pieces-legend').hidden = !state.pieces;
       requestRender(viewer);
     });
+  }
+  if (viewer.colours.pieces) {
+    $('pieces-option').hidden = false;
+    renderPieceLegend(viewer.treatmentNames, viewer.treatmentCounts);
   }
   for (const key of ['skeleton', 'curves']) {
     $(`show-${key}`).addEventListener('change', (event) => {

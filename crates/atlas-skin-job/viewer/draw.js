@@ -1,5 +1,5 @@
-// Drawing a frame on demand: the meshes skinned on the GPU (region colours or one joint's
-// weights), the boundary curves, the skeleton on top; the animation advancing while it plays.
+// Drawing a frame on demand: the meshes skinned on the GPU (region or piece colours or one
+// joint's weights), the boundary curves, the skeleton on top; the animation advancing while it plays.
 
 // Draws the current state: the animation's pose at state.time with the user's rotations.
 function render(viewer) {
@@ -31,10 +31,11 @@ function render(viewer) {
   gl.bindVertexArray(null);
 }
 
-// Every mesh with its skin's palette; in the heat-map view the main skin's meshes show the
-// selected joint's weights.
+// Every mesh with its skin's palette, coloured by region or by piece treatment; in the
+// heat-map view the main skin's meshes show the selected joint's weights.
 function drawMeshes(viewer) {
   const { gl, state } = viewer;
+  showColours(viewer, state.pieces ? 'pieces' : 'regions');
   const program = viewer.programs.mesh;
   // Constant influences for vertex arrays without JOINTS/WEIGHTS: the mesh's own node.
   gl.vertexAttribI4ui(3, 0, 0, 0, 0);

@@ -84,6 +84,18 @@ function uploadMeshes(gl, items, colours) {
   return textures;
 }
 
+// Puts colour set `name` of `viewer.colours` (`regions` or `pieces`, one array per mesh)
+// into the meshes' colour buffers, unless it is there already.
+function showColours(viewer, name) {
+  const { gl, items } = viewer;
+  if (viewer.shownColours === name) return;
+  items.forEach((item, i) => {
+    gl.bindBuffer(gl.ARRAY_BUFFER, item.gpu.buffers.a_color);
+    gl.bufferSubData(gl.ARRAY_BUFFER, 0, viewer.colours[name][i]);
+  });
+  viewer.shownColours = name;
+}
+
 // The report's boundaries as line segments skinned like the main mesh: `cutVertices`
 // vertices of cuts, then the soft boundaries' circles; `count` vertices in all.
 function uploadCurves(gl, report, main) {

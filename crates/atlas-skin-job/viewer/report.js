@@ -63,6 +63,56 @@ function regionColours(model) {
   return { colours, dominantCount };
 }
 
+// Fixed colour of each piece treatment the report names (pieces.treatments); a name this
+// viewer does not know is grey.
+const TREATMENT_COLOURS = {
+  body: [0.6, 0.66, 0.75],
+  attached: [0.2, 0.72, 0.66],
+  rigid: [0.95, 0.68, 0.18],
+  joints: [0.62, 0.42, 0.88],
+  fallback: [0.92, 0.22, 0.22],
+};
+const treatmentColour = (name) => TREATMENT_COLOURS[name] || [0.45, 0.45, 0.45];
+
+// The report's treatment of every vertex of the main mesh: the treatment names and each
+// vertex's index into them (pieces.treatments, pieces.vertex_treatments); null without
+// them or when their length is not the main mesh's vertex count.
+function vertexTreatments(model) {
+  const pieces = model.report && model.report.pieces;
+  const names = pieces && pieces.treatments;
+  const indices = pieces && pieces.vertex_treatments;
+  if (!Array.isArray(names) || !Array.isArray(indices) || indices.length !== model.main.vertexCount) return null;
+  return { names: names.map(String), indices };
+}
+
+// Vertex colours of each mesh in the pieces view: for the main mesh its vertex's treatment
+// colour, grey elsewhere; and how many vertices of the main mesh each treatment has.
+function pieceColours(model, treatments) {
+  const counts = new Map();
+  const colours = model.items.map((item) => {
+    const rgb = new Float32Array(item.vertexCount * 3);
+    for (let v = 0; v < item.vertexCount; v++) {
+      const name = item === model.main ? treatments.names[treatments.indices[v]] : undefined;
+      if (name !== undefined) counts.set(name, (counts.get(name) || 0) + 1);
+      rgb.set(treatmentColour(name), v * 3);
+    }
+    return rgb;
+  });
+  return { colours, counts };
+}
+
+// The pieces view's legend: a swatch, the name and the vertex count of every treatment
+// present, in the report's order.
+function renderPieceLegend(names, counts) {
+  const legend = $('pieces-legend');
+  for (const name of names.filter((n) => counts.has(n))) {
+    const entry = legend.appendChild(element('span', undefined, 'treatment'));
+    const swatch = entry.appendChild(element('span', undefined, 'swatch area'));
+    swatch.style.background = `rgb(${treatmentColour(name).map((c) => Math.round(c * 255)).join(',')})`;
+    entry.appendChild(document.createTextNode(`${name} ${counts.get(name)}`));
+  }
+}
+
 // Boundaries as closed polylines in bind space: `cuts` from decomposition.joints[].curve,
 // `planes` a circle of the boundary's diameter in its plane (point, normal) for a joint
 // with a plane but no curve (a soft boundary).

@@ -8,8 +8,10 @@
 // diameter, overlap*, point [x,y,z], normal [x,y,z], curve [[x,y,z], ...] (bind space)},
 // decomposition.regions[] {joint, joints: [name...]}, decomposition.vertex_regions (region
 // index or null per vertex of the main skinned mesh, glTF vertex order; otherwise, and for
-// null, a vertex takes the region of its dominant joint), timings_ms {stage: ms}, warnings
-// [...], counts {...} and any other top-level scalar.
+// null, a vertex takes the region of its dominant joint), pieces.treatments [name...] with
+// pieces.vertex_treatments (an index into them per vertex of the main mesh, glTF vertex
+// order: the "pieces" colour mode), timings_ms {stage: ms}, warnings [...], counts {...} and
+// any other top-level scalar.
 
 const $ = (id) => document.getElementById(id);
 const hook = (window.atlasViewer = { ready: false, error: null });
@@ -30,8 +32,10 @@ function loadModel() {
 }
 
 // What the viewer's parts share: the model, the canvas's WebGL2 context with the programs
-// and the uploaded model, the joint tree, the camera framing the rest pose, the panel's
-// `state`, the last frame's view-projection and the animation player's frame clock.
+// and the uploaded model, the vertex colours by region and by piece treatment (null without
+// the report's treatments) with the treatments' names and vertex counts, the joint tree,
+// the camera framing the rest pose, the panel's `state`, the last frame's view-projection
+// and the animation player's frame clock.
 function createViewer(model) {
   const canvas = $('view');
   const gl = canvas.getContext('webgl2', { antialias: true });
@@ -42,14 +46,18 @@ function createViewer(model) {
     feedback: null,
   };
   const { colours, dominantCount } = regionColours(model);
+  const treatments = vertexTreatments(model);
+  const pieces = treatments ? pieceColours(model, treatments) : { colours: null, counts: new Map() };
   const textures = uploadMeshes(gl, model.items, colours);
   const curves = uploadCurves(gl, model.report, model.main);
   const tree = jointTree(model.scene, model.mainSkin);
   const skeleton = uploadSkeleton(gl, model.mainSkin.joints.length, tree.bones.length);
   return {
     ...model, canvas, gl, programs, textures, curves, tree, skeleton, dominantCount,
+    colours: { regions: colours, pieces: pieces.colours }, shownColours: 'regions',
+    treatmentNames: treatments ? treatments.names : [], treatmentCounts: pieces.counts,
     camera: frameCamera(restPoseBounds(model.scene, model.items)),
-    state: { joint: 0, heat: false, dqs: false, skeleton: true, curves: true, animation: -1, time: 0, playing: false },
+    state: { joint: 0, heat: false, pieces: false, dqs: false, skeleton: true, curves: true, animation: -1, time: 0, playing: false },
     viewProjection: mat4.identity(),
     playback: { requested: false, lastFrame: 0 },
   };

@@ -561,6 +561,12 @@ fn vertices_no_region_with_joints_reaches_take_the_nearest_weights() {
     // The middle of the top bar copies a neighbour region's weights.
     let middle = nearest_vertex(&mesh, DVec3::new(3.0, 9.0, 0.0));
     assert!(weights.row(middle).all(|(j, _)| j == 0 || j == 2));
+    // The fallback's vertices are listed: the top bar's, none of the tetrahedron's.
+    let listed = &counts.from_surface_vertices;
+    assert_eq!(listed.len(), counts.from_surface);
+    assert!(listed.windows(2).all(|w| w[0] < w[1]));
+    assert!(listed.contains(&(middle as u32)));
+    assert!(listed.iter().all(|&v| v < base && region_of(v) == top_bar));
 }
 
 /// A straight tube along x from 0 to 12 (radius 1), one region, and a fork at its root:

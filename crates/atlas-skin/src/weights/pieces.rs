@@ -217,6 +217,7 @@ fn fill_body_gaps(
     for v in (0..n).filter(|&v| empty[v]) {
         if let Some(source) = nearest.source(v as u32) {
             counts.from_surface += 1;
+            counts.from_surface_vertices.push(v as u32);
             rows[v] = Some(weights.row(source as usize).collect());
         }
     }

@@ -45,6 +45,8 @@ pub struct WeightCounts {
     /// Of those, vertices of decomposed pieces weighted from the nearest weighted vertex
     /// along their piece's edges (the fallback).
     pub from_surface: usize,
+    /// The split-surface vertices counted in `from_surface`, ascending.
+    pub from_surface_vertices: Vec<u32>,
     /// Of those, vertices of pieces that span a joint with no body beneath, bent at the
     /// boundary planes of their joints.
     pub bent: usize,
