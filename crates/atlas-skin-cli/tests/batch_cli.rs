@@ -250,12 +250,22 @@ fn a_killed_batch_leaves_complete_files_and_resume_finishes_it() {
         assert!(is_complete_glb(glb), "{} is incomplete", glb.display());
     }
 
+    // What a write killed before its rename leaves, and a file that only looks alike.
+    let leftover = out.join(".Knight.glb.0123456789abcdef.tmp");
+    let kept = out.join(".Knight.glb.notes.tmp");
+    std::fs::write(&leftover, b"half a glb").unwrap();
+    std::fs::write(&kept, b"mine").unwrap();
     let stdout = batch_ok(&[
         bench.as_os_str(),
         "-o".as_ref(),
         out.as_os_str(),
         "--resume".as_ref(),
     ]);
+    assert!(
+        !leftover.exists(),
+        "--resume removes the killed run's temporary files"
+    );
+    assert!(kept.exists());
     let records = log_records(&log);
     let skipped = records.iter().filter(|r| r["status"] == "skipped").count();
     assert_eq!(records.len(), 65);

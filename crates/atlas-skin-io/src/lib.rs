@@ -32,4 +32,4 @@ pub mod tgf;
 pub use character::{Character, LoadOptions, Material, MeshPart, PartBinding, TriangleMesh};
 pub use error::IoError;
 pub use load::load_character;
-pub use output::OutputPlan;
+pub use output::{remove_leftover_temporaries, OutputPlan};

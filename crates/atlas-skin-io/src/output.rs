@@ -151,11 +151,7 @@ fn write_atomically(out: &Path, bytes: &[u8]) -> std::io::Result<()> {
     }
     let mut attempt = 0;
     let (temporary, mut file) = loop {
-        let temporary = out.with_file_name(format!(
-            ".{}.{:016x}.tmp",
-            name.to_string_lossy(),
-            random_u64()
-        ));
+        let temporary = out.with_file_name(temporary_name(name, random_u64()));
         match std::fs::OpenOptions::new()
             .write(true)
             .create_new(true)
@@ -180,6 +176,42 @@ fn write_atomically(out: &Path, bytes: &[u8]) -> std::io::Result<()> {
         let _ = std::fs::remove_file(&temporary);
     }
     result
+}
+
+/// The name of a temporary file for an output named `name`: `.NAME.<16 hex digits>.tmp`.
+fn temporary_name(name: &std::ffi::OsStr, random: u64) -> String {
+    format!(".{}.{random:016x}.tmp", name.to_string_lossy())
+}
+
+/// Removes the temporary files beside `out` that writes of `out` killed before their
+/// rename left behind (names as [`temporary_name`] makes them); returns how many. For a
+/// run that resumes killed work; a write of `out` running at the same time would lose its
+/// file.
+pub fn remove_leftover_temporaries(out: &Path) -> usize {
+    let (Some(name), Some(folder)) = (out.file_name(), out.parent()) else {
+        return 0;
+    };
+    let folder = if folder.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        folder
+    };
+    let prefix = format!(".{}.", name.to_string_lossy());
+    let Ok(entries) = std::fs::read_dir(folder) else {
+        return 0;
+    };
+    entries
+        .flatten()
+        .filter(|entry| {
+            let file = entry.file_name();
+            let file = file.to_string_lossy();
+            file.strip_prefix(&prefix)
+                .and_then(|rest| rest.strip_suffix(".tmp"))
+                .is_some_and(|hex| hex.len() == 16 && hex.bytes().all(|b| b.is_ascii_hexdigit()))
+                && entry.file_type().is_ok_and(|t| t.is_file())
+        })
+        .filter(|entry| std::fs::remove_file(entry.path()).is_ok())
+        .count()
 }
 
 /// A random number from the standard library's randomly seeded hasher (no dependency).

@@ -1,7 +1,8 @@
 //! Many characters at once (`atlas-skin batch`, `atlas_skin.batch`): the inputs (files,
 //! folders searched for character files, glob patterns) each skinned by a [`SkinJob`] to
 //! `OUTDIR/<name>.glb` (with `<name>.json` and `<name>.html` when asked), several at a time
-//! on a pool of threads. A failing file is recorded and the others go on; `resume` skips
+//! on a pool of threads. A failing file is recorded and the others go on; `resume` removes
+//! the temporary files a killed run left beside the outputs and skips
 //! the files whose outputs exist and are newer than the file (and the settings file).
 //! Every finished file appends one JSON record to the log (flushed at once, so a killed
 //! batch keeps the records of what it finished); the outputs themselves are written as
@@ -318,8 +319,19 @@ fn run_one(job: &SkinJob, resume: bool, stop: &AtomicBool) -> Record {
         record.status = Status::Cancelled;
         return record;
     }
-    if resume && up_to_date(job) {
-        return record;
+    if resume {
+        // Files a killed run was writing when it stopped.
+        let outputs = &job.outputs;
+        std::iter::once(&outputs.glb)
+            .chain(outputs.report.iter())
+            .chain(outputs.html.iter())
+            .chain(outputs.debug_glb.iter())
+            .for_each(|out| {
+                atlas_skin_io::remove_leftover_temporaries(out);
+            });
+        if up_to_date(job) {
+            return record;
+        }
     }
     match job.run(&mut |_| {}) {
         Ok(outcome) => {
