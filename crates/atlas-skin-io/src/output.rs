@@ -184,7 +184,7 @@ fn temporary_name(name: &std::ffi::OsStr, random: u64) -> String {
 }
 
 /// Removes the temporary files beside `out` that writes of `out` killed before their
-/// rename left behind (names as [`temporary_name`] makes them); returns how many. For a
+/// rename left behind (named `.NAME.<16 hex digits>.tmp`); returns how many. For a
 /// run that resumes killed work; a write of `out` running at the same time would lose its
 /// file.
 pub fn remove_leftover_temporaries(out: &Path) -> usize {
