@@ -66,13 +66,6 @@ pub fn skin_report(
     let mut warnings = input_warnings.to_vec();
     warnings.extend(skinned.warnings.iter().cloned());
     let weight_counts = &counts.weights;
-    if weight_counts.from_surface > 0 {
-        warnings.push(format!(
-            "fallback: {} vertices of decomposed pieces lie in regions no joint reaches and took \
-             the weights of the nearest weighted vertex along their piece",
-            weight_counts.from_surface
-        ));
-    }
     if !weight_counts.inactive_soft_joints.is_empty() {
         let names: Vec<&str> = weight_counts
             .inactive_soft_joints
@@ -102,8 +95,7 @@ pub fn skin_report(
             "joints": counts.joints,
             "regions": decomposition.regions.len(),
             "unreachable_vertices": weight_counts.unreachable,
-            "fallback_weighted_vertices": weight_counts.from_surface
-                + counts.unreferenced_stored_vertices,
+            "fallback_weighted_vertices": counts.unreferenced_stored_vertices,
             "max_influences": skinned.weights.max_influences(),
             "leaf_patches": weight_counts.leaf_patches.len(),
             "far_bone_vertices": weight_counts.far_bone_vertices,
@@ -118,8 +110,7 @@ pub fn skin_report(
 /// The treatments of the report's `pieces.treatments`, in that order: a vertex's piece was
 /// decomposed (`body`), attached to the body surface, bound rigidly to one joint, bent at
 /// its joints ([`PieceTreatment`]), or the vertex was weighted by a fallback (`fallback`: a
-/// vertex of a body piece no region with joints reaches, or a stored vertex no triangle
-/// uses; the warnings say how many of each).
+/// stored vertex no triangle uses, bound to its nearest bone; the warnings say how many).
 pub const TREATMENTS: [&str; 5] = ["body", "attached", "rigid", "joints", "fallback"];
 /// Index of `fallback` in [`TREATMENTS`].
 const FALLBACK: usize = 4;
@@ -136,44 +127,56 @@ fn treatment_index(treatment: PieceTreatment) -> usize {
 
 /// How the pieces were weighted: per treatment the number of pieces and vertices
 /// (`by_treatment`), every piece that was not decomposed (`not_decomposed`: `attached`,
-/// `rigid` with its joint, `joints`), and the treatment of every stored vertex
+/// `rigid` with its joint, `joints`), every gap of a body piece weighted as a whole
+/// (`gaps`: the parts no region with joints reaches, with the same treatments), and the
+/// treatment of every stored vertex
 /// (`vertex_treatments`: an index into `treatments`, [`TREATMENTS`]).
 fn pieces_report(skinned: &Skinned) -> Value {
     let decomposition = &skinned.decomposition;
     let counts = &skinned.counts.weights;
     let mut summary = serde_json::Map::new();
+    let joint_name = |treatment: PieceTreatment| match treatment {
+        PieceTreatment::Rigid(j) => Some(decomposition.joints[j as usize].name.clone()),
+        _ => None,
+    };
     let mut loose = Vec::new();
     for piece in &counts.pieces {
         let name = TREATMENTS[treatment_index(piece.treatment)];
         let entry = summary
             .entry(name)
-            .or_insert_with(|| json!({"pieces": 0, "vertices": 0, "fallback_vertices": 0}));
-        for (key, add) in [
-            ("pieces", 1),
-            ("vertices", piece.vertices),
-            ("fallback_vertices", piece.fallback_vertices),
-        ] {
+            .or_insert_with(|| json!({"pieces": 0, "vertices": 0}));
+        for (key, add) in [("pieces", 1), ("vertices", piece.vertices)] {
             entry[key] = json!(entry[key].as_u64().unwrap_or(0) + add as u64);
         }
         if piece.treatment != PieceTreatment::Body {
-            let joint = match piece.treatment {
-                PieceTreatment::Rigid(j) => Some(decomposition.joints[j as usize].name.clone()),
-                _ => None,
-            };
+            let joint = joint_name(piece.treatment);
             loose.push(json!({"treatment": name, "joint": joint, "vertices": piece.vertices}));
         }
     }
+    let gaps: Vec<Value> = counts
+        .gaps
+        .iter()
+        .map(|gap| {
+            json!({
+                "treatment": TREATMENTS[treatment_index(gap.treatment)],
+                "joint": joint_name(gap.treatment),
+                "vertices": gap.vertices.len(),
+            })
+        })
+        .collect();
     json!({
         "by_treatment": summary,
         "not_decomposed": loose,
+        "gaps": gaps,
         "treatments": TREATMENTS,
         "vertex_treatments": vertex_treatments(skinned),
     })
 }
 
-/// The index in [`TREATMENTS`] of every stored vertex: `fallback` when the fallback
-/// weighted its surface vertex or no triangle uses it, else its piece's treatment (the piece
-/// of the split surface that holds its welded vertex).
+/// The index in [`TREATMENTS`] of every stored vertex: `fallback` when no triangle uses
+/// it, else the treatment of its gap when its welded vertex lies in a gap of a body piece,
+/// else its piece's treatment (the piece of the split surface that holds its welded
+/// vertex).
 fn vertex_treatments(skinned: &Skinned) -> Vec<usize> {
     let d = &skinned.decomposition;
     let counts = &skinned.counts.weights;
@@ -182,8 +185,10 @@ fn vertex_treatments(skinned: &Skinned) -> Vec<usize> {
         .iter()
         .map(|&c| treatment_index(counts.pieces[c as usize].treatment))
         .collect();
-    for &v in &counts.from_surface_vertices {
-        of_surface[v as usize] = FALLBACK;
+    for gap in &counts.gaps {
+        for &v in &gap.vertices {
+            of_surface[v as usize] = treatment_index(gap.treatment);
+        }
     }
     skinned
         .welded_of_stored

@@ -504,7 +504,7 @@ fn unwelded_weights_keep_the_largest_influences_and_renormalise() {
 }
 
 #[test]
-fn vertices_no_region_with_joints_reaches_take_the_nearest_weights() {
+fn a_gap_of_a_decomposed_piece_is_weighted_as_a_whole() {
     let (mut mesh, skeleton, points) = hand_touching_thigh();
     // A loose tetrahedron beside the thigh bone, like an eye or a tooth.
     let base = mesh.vertex_count() as u32;
@@ -548,25 +548,26 @@ fn vertices_no_region_with_joints_reaches_take_the_nearest_weights() {
     .expect("weights");
     assert_partition_of_unity(&weights);
     // The tetrahedron spans no joint: rigid to the bone it sits by; the top bar, a region
-    // of a decomposed piece, takes its weights along the piece (the fallback).
-    assert_eq!((counts.rigid, counts.bent, counts.attached), (4, 0, 0));
-    assert!(counts.from_surface > 50, "{counts:?}");
-    assert_eq!(counts.unreachable, counts.rigid + counts.from_surface);
+    // of a decomposed piece that no region with joints reaches, is a gap weighted as a
+    // whole: it holds the bone of joint 1 (the hip, across the bar) and nothing else, so it
+    // moves rigidly with it, as the bar between hip and shoulder should.
+    assert_eq!(counts.unreachable, counts.rigid);
+    assert_eq!((counts.bent, counts.attached), (0, 0));
     let treatments: Vec<PieceTreatment> = counts.pieces.iter().map(|p| p.treatment).collect();
     assert_eq!(treatments, [PieceTreatment::Body, PieceTreatment::Rigid(0)]);
-    assert_eq!(counts.pieces[0].fallback_vertices, counts.from_surface);
     for v in base..base + 4 {
         assert_eq!(weights.row(v as usize).collect::<Vec<_>>(), vec![(0, 1.0)]);
     }
-    // The middle of the top bar copies a neighbour region's weights.
-    let middle = nearest_vertex(&mesh, DVec3::new(3.0, 9.0, 0.0));
-    assert!(weights.row(middle).all(|(j, _)| j == 0 || j == 2));
-    // The fallback's vertices are listed: the top bar's, none of the tetrahedron's.
-    let listed = &counts.from_surface_vertices;
-    assert_eq!(listed.len(), counts.from_surface);
-    assert!(listed.windows(2).all(|w| w[0] < w[1]));
-    assert!(listed.contains(&(middle as u32)));
-    assert!(listed.iter().all(|&v| v < base && region_of(v) == top_bar));
+    assert_eq!(counts.gaps.len(), 1, "{counts:?}");
+    let gap = &counts.gaps[0];
+    assert_eq!(gap.treatment, PieceTreatment::Rigid(1));
+    assert_eq!(gap.vertices.len() + 4, counts.unreachable);
+    let middle = nearest_vertex(&mesh, DVec3::new(3.0, 9.0, 0.0)) as u32;
+    assert!(gap.vertices.contains(&middle));
+    for &v in &gap.vertices {
+        assert!(v < base && region_of(v) == top_bar);
+        assert_eq!(weights.row(v as usize).collect::<Vec<_>>(), vec![(1, 1.0)]);
+    }
 }
 
 /// A straight tube along x from 0 to 12 (radius 1), one region, and a fork at its root:

@@ -59,8 +59,8 @@
 //!    reaches is weighted as a whole by its geometry ([`crate::weights::pieces`]): attached
 //!    to the body surface it sits on (weights of the nearest body point, interpolated over
 //!    its face), rigid to one joint when it spans none, or bent at its joints by the
-//!    nearest bone. A vertex of a decomposed piece that no region reaches copies the
-//!    weights of the nearest weighted vertex along the piece's edges (the fallback).
+//!    nearest bone. The vertices of a decomposed piece that no region reaches (its gaps)
+//!    are weighted as a whole by the same rules.
 //! 5. **Guard.** A weight on a joint whose bones are far from the vertex, many times
 //!    farther than the nearest bone reached through the body, is removed and the row
 //!    renormalised ([`guard`]); the pipeline runs it on the result of steps 1–4.

@@ -42,11 +42,6 @@ impl SurfaceWeights {
 pub struct WeightCounts {
     /// Surface vertices no region with joints reaches.
     pub unreachable: usize,
-    /// Of those, vertices of decomposed pieces weighted from the nearest weighted vertex
-    /// along their piece's edges (the fallback).
-    pub from_surface: usize,
-    /// The split-surface vertices counted in `from_surface`, ascending.
-    pub from_surface_vertices: Vec<u32>,
     /// Of those, vertices of pieces that span a joint with no body beneath, bent at the
     /// boundary planes of their joints.
     pub bent: usize,
@@ -56,6 +51,8 @@ pub struct WeightCounts {
     pub rigid: usize,
     /// Every piece (connected component of the split surface) and how it was weighted.
     pub pieces: Vec<PieceWeighting>,
+    /// The gaps of body pieces weighted as a whole, like pieces without weights.
+    pub gaps: Vec<GapWeighting>,
     /// Joints whose soft boundary is inactive (no cross-section near the joint).
     pub inactive_soft_joints: Vec<u32>,
     /// Leaf joints that move a patch of skin (step 3b).
@@ -85,6 +82,14 @@ pub struct PieceWeighting {
     #[serde(flatten)]
     pub treatment: PieceTreatment,
     pub vertices: usize,
-    /// Vertices of a body piece that no region with joints reaches (the fallback).
-    pub fallback_vertices: usize,
+}
+
+/// A gap of a body piece (vertices no region with joints reaches, joined by edges) and how
+/// it was weighted as a whole.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct GapWeighting {
+    #[serde(flatten)]
+    pub treatment: PieceTreatment,
+    /// Its split-surface vertices.
+    pub vertices: Vec<u32>,
 }
