@@ -209,7 +209,8 @@ fn no_vertex_takes_weight_from_a_bone_far_beyond_its_nearest() {
     let demo = demo_character(0.02);
     let pieces = demo_in_pieces(0.02);
     let as_f32 = |points: &[DVec3]| points.iter().map(|p| p.as_vec3()).collect::<Vec<Vec3>>();
-    let shapes: Vec<(&str, Vec<Vec3>, &[[u32; 3]], &Skeleton)> = vec![
+    type Shape<'a> = (&'a str, Vec<Vec3>, &'a [[u32; 3]], &'a Skeleton);
+    let shapes: Vec<Shape> = vec![
         (
             "bent tube",
             as_f32(&tube.positions),
