@@ -434,6 +434,28 @@ fn a_character_in_pieces_shows_each_piece_treatment_in_its_colour() {
     assert_legend_matches_report(&checks, &report);
 }
 
+/// A character of several skinned meshes and rigid meshes under joints
+/// (robotexpressive: 4 skins over one skeleton, 15 rigid meshes): the report says which
+/// stored vertices every primitive holds (`vertex_ranges`, covering all of them once), and
+/// the pieces view colours every mesh, not only the largest: its legend counts every
+/// stored vertex of the report.
+#[test]
+fn a_character_of_many_meshes_shows_every_mesh_in_the_pieces_view() {
+    let input = data_file("bench/robotexpressive/RobotExpressive.glb");
+    let (report, html) = skin_with_report("pieces_robot", Some(&input));
+    let ranges = report["vertex_ranges"].as_array().expect("vertex_ranges");
+    assert_eq!(ranges.len(), 19, "{ranges:#?}");
+    let mut next = 0;
+    for range in ranges {
+        assert_eq!(range["first"].as_u64(), Some(next), "{range}");
+        next += range["count"].as_u64().expect("count");
+    }
+    assert_eq!(Some(next), report["counts"]["vertices"].as_u64());
+    let checks = drive("pieces_robot", &html);
+    assert_eq!(checks["pieces_offered"], true);
+    assert_legend_matches_report(&checks, &report);
+}
+
 #[test]
 fn makehuman_skinned_by_the_project_opens_with_its_163_joints() {
     let dir = output_dir();

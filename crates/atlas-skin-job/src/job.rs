@@ -5,7 +5,7 @@
 //! [`OutputPlan`], checked before any work: complete or untouched, never over an input.
 
 use crate::html::{write_html, HtmlError};
-use crate::report::{skin_report, stage_timings};
+use crate::report::{skin_report, stage_timings, vertex_ranges};
 use crate::settings::{Settings, SettingsError};
 use atlas_skin::pipeline::{skin, SkinError, SkinInput, Skinned};
 use atlas_skin::report::{debug_colors, debug_lines};
@@ -210,7 +210,10 @@ impl SkinJob {
         timings.insert("write".into(), json!(start.elapsed().as_secs_f64() * 1e3));
 
         let input_name = character.path.display().to_string();
-        let report = skin_report(&input_name, &character.warnings, &skinned, timings);
+        let mut report = skin_report(&input_name, &character.warnings, &skinned, timings);
+        if let Some(source) = &character.gltf {
+            report["vertex_ranges"] = vertex_ranges(source);
+        }
         if let Some(path) = &outputs.report {
             let text = serde_json::to_string_pretty(&report).map_err(JobError::Report)?;
             plan.write(path, text.as_bytes())?;

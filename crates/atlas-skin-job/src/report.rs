@@ -5,6 +5,7 @@
 use atlas_skin::pipeline::Skinned;
 use atlas_skin::weights::pieces::PieceTreatment;
 use atlas_skin::BoundaryKind;
+use atlas_skin_io::gltf::GltfSource;
 use serde_json::{json, Map, Value};
 
 /// Wall time of each stage of the method, in milliseconds, keyed by stage name.
@@ -105,6 +106,26 @@ pub fn skin_report(
         "pieces": pieces_report(skinned),
         "warnings": warnings,
     })
+}
+
+/// Where the report's per-vertex arrays (`decomposition.vertex_regions`,
+/// `pieces.vertex_treatments`) come from in a glTF input, whose written file keeps its
+/// nodes, meshes and primitives: per triangle primitive read, its node, mesh and primitive
+/// index and its stored vertices `first .. first + count` (primitives that share one
+/// POSITION accessor share their range). The viewer colours every such primitive, not only
+/// the largest skinned mesh (several skins, rigid meshes under joints).
+pub fn vertex_ranges(source: &GltfSource) -> Value {
+    json!(source
+        .primitives
+        .iter()
+        .map(|p| json!({
+            "node": p.node,
+            "mesh": p.mesh,
+            "primitive": p.primitive,
+            "first": p.vertices.start,
+            "count": p.vertices.len(),
+        }))
+        .collect::<Vec<_>>())
 }
 
 /// The treatments of the report's `pieces.treatments`, in that order: a vertex's piece was

@@ -158,14 +158,14 @@ function readPrimitives(gltf, scene, skins) {
     if (node.mesh === undefined) continue;
     // An unskinned mesh follows its node: a one-joint skin with the node as the joint.
     const skin = node.skin !== undefined ? skins[node.skin] : { joints: [nodeIndex], inverseBind: () => mat4.identity(), palette: new Float32Array(28), rigid: true };
-    for (const primitive of gltf.json.meshes[node.mesh].primitives) {
+    gltf.json.meshes[node.mesh].primitives.forEach((primitive, primitiveIndex) => {
       const attributes = primitive.attributes;
-      if ((primitive.mode !== undefined && primitive.mode !== 4) || attributes.POSITION === undefined) continue;
+      if ((primitive.mode !== undefined && primitive.mode !== 4) || attributes.POSITION === undefined) return;
       const positions = readAccessor(gltf, attributes.POSITION);
       const vertexCount = positions.length / 3;
       const indices = primitive.indices !== undefined ? readAccessor(gltf, primitive.indices, true) : Uint32Array.from({ length: vertexCount }, (_, i) => i);
       const item = {
-        skin, positions, indices, vertexCount,
+        skin, positions, indices, vertexCount, node: nodeIndex, primitive: primitiveIndex,
         normals: attributes.NORMAL !== undefined ? readAccessor(gltf, attributes.NORMAL) : smoothNormals(positions, indices),
       };
       if (!skin.rigid && attributes.JOINTS_0 !== undefined && attributes.WEIGHTS_0 !== undefined) {
@@ -184,7 +184,7 @@ function readPrimitives(gltf, scene, skins) {
         normaliseWeights(item.weights0, item.weights1);
       }
       items.push(item);
-    }
+    });
   }
   return items;
 }

@@ -40,20 +40,34 @@ function regionOfJoints(scene, skin, report) {
   });
 }
 
-// Vertex colours of each mesh, the hue of the vertex's region: for the main mesh the
-// report's vertex_regions when given, else the region of its dominant joint (region 0 in
-// meshes of other skins); and the number of vertices each main-skin joint dominates.
+// Where each mesh's vertices start in one of the report's per-vertex arrays of `length`
+// entries (decomposition.vertex_regions, pieces.vertex_treatments): by the report's
+// vertex_ranges (the node and primitive of every range of stored vertices) when given, else
+// 0 for the main mesh when the array has its vertex count; -1 for a mesh it does not cover.
+function reportOffsets(model, length) {
+  const ranges = model.report && Array.isArray(model.report.vertex_ranges) ? model.report.vertex_ranges : null;
+  return model.items.map((item) => {
+    if (!ranges) return item === model.main && length === item.vertexCount ? 0 : -1;
+    const range = ranges.find((r) => r.node === item.node && r.primitive === item.primitive);
+    return range && range.count === item.vertexCount && range.first + range.count <= length ? range.first : -1;
+  });
+}
+
+// Vertex colours of each mesh, the hue of the vertex's region: the report's vertex_regions
+// where they cover the mesh (reportOffsets), else the region of its dominant joint (region 0
+// in meshes of other skins); and the number of vertices each main-skin joint dominates.
 function regionColours(model) {
-  const { report, items, main, mainSkin } = model;
+  const { report, items, mainSkin } = model;
   const regionOf = regionOfJoints(model.scene, mainSkin, report);
   const vertexRegions = report && report.decomposition && report.decomposition.vertex_regions;
-  const explicitRegions = Array.isArray(vertexRegions) && vertexRegions.length === main.vertexCount ? vertexRegions : null;
+  const explicitRegions = Array.isArray(vertexRegions) ? vertexRegions : [];
+  const offsets = reportOffsets(model, explicitRegions.length);
   const dominantCount = new Uint32Array(mainSkin.joints.length);
-  const colours = items.map((item) => {
+  const colours = items.map((item, i) => {
     const dominant = dominantJoints(item);
     const rgb = new Float32Array(item.vertexCount * 3);
     for (let v = 0; v < item.vertexCount; v++) {
-      const explicit = item === main && explicitRegions ? explicitRegions[v] : null;
+      const explicit = offsets[i] >= 0 ? explicitRegions[offsets[i] + v] : null;
       const region = Number.isInteger(explicit) ? explicit : item.skin === mainSkin ? regionOf[dominant[v]] : 0;
       if (item.skin === mainSkin) dominantCount[dominant[v]]++;
       rgb.set(hslToRgb(regionHue(region), 0.55, 0.6), v * 3);
@@ -74,25 +88,28 @@ const TREATMENT_COLOURS = {
 };
 const treatmentColour = (name) => TREATMENT_COLOURS[name] || [0.45, 0.45, 0.45];
 
-// The report's treatment of every vertex of the main mesh: the treatment names and each
-// vertex's index into them (pieces.treatments, pieces.vertex_treatments); null without
-// them or when their length is not the main mesh's vertex count.
+// The report's treatment of the stored vertices: the treatment names, each vertex's index
+// into them (pieces.treatments, pieces.vertex_treatments) and where each mesh's vertices
+// start in them (reportOffsets); null without them or when they cover no mesh.
 function vertexTreatments(model) {
   const pieces = model.report && model.report.pieces;
   const names = pieces && pieces.treatments;
   const indices = pieces && pieces.vertex_treatments;
-  if (!Array.isArray(names) || !Array.isArray(indices) || indices.length !== model.main.vertexCount) return null;
-  return { names: names.map(String), indices };
+  if (!Array.isArray(names) || !Array.isArray(indices)) return null;
+  const offsets = reportOffsets(model, indices.length);
+  if (offsets.every((offset) => offset < 0)) return null;
+  return { names: names.map(String), indices, offsets };
 }
 
-// Vertex colours of each mesh in the pieces view: for the main mesh its vertex's treatment
-// colour, grey elsewhere; and how many vertices of the main mesh each treatment has.
+// Vertex colours of each mesh in the pieces view: its vertex's treatment colour where the
+// report covers the mesh, grey elsewhere; and how many vertices each treatment has.
 function pieceColours(model, treatments) {
   const counts = new Map();
-  const colours = model.items.map((item) => {
+  const colours = model.items.map((item, i) => {
+    const offset = treatments.offsets[i];
     const rgb = new Float32Array(item.vertexCount * 3);
     for (let v = 0; v < item.vertexCount; v++) {
-      const name = item === model.main ? treatments.names[treatments.indices[v]] : undefined;
+      const name = offset >= 0 ? treatments.names[treatments.indices[offset + v]] : undefined;
       if (name !== undefined) counts.set(name, (counts.get(name) || 0) + 1);
       rgb.set(treatmentColour(name), v * 3);
     }

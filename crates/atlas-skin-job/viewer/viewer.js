@@ -7,11 +7,12 @@
 // Report keys read (all optional): decomposition.joints[] {name, status, reason, perimeter,
 // diameter, overlap*, point [x,y,z], normal [x,y,z], curve [[x,y,z], ...] (bind space)},
 // decomposition.regions[] {joint, joints: [name...]}, decomposition.vertex_regions (region
-// index or null per vertex of the main skinned mesh, glTF vertex order; otherwise, and for
-// null, a vertex takes the region of its dominant joint), pieces.treatments [name...] with
-// pieces.vertex_treatments (an index into them per vertex of the main mesh, glTF vertex
-// order: the "pieces" colour mode), timings_ms {stage: ms}, warnings [...], counts {...} and
-// any other top-level scalar.
+// index or null per stored vertex; otherwise, and for null, a vertex takes the region of
+// its dominant joint), pieces.treatments [name...] with pieces.vertex_treatments (an index
+// into them per stored vertex: the "pieces" colour mode), vertex_ranges [{node, primitive,
+// first, count}] (which stored vertices each primitive of the file holds; without it the
+// per-vertex arrays are the main skinned mesh's, glTF vertex order), timings_ms
+// {stage: ms}, warnings [...], counts {...} and any other top-level scalar.
 
 const $ = (id) => document.getElementById(id);
 const hook = (window.atlasViewer = { ready: false, error: null });
