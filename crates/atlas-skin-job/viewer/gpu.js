@@ -96,11 +96,12 @@ function showColours(viewer, name) {
   viewer.shownColours = name;
 }
 
-// The report's boundaries as line segments skinned like the main mesh: `cutVertices`
-// vertices of cuts, then the soft boundaries' circles; `count` vertices in all.
-function uploadCurves(gl, report, main) {
+// The report's boundaries as line segments skinned like the nearest of `meshes`
+// (curveMeshes): `cutVertices` vertices of cuts, then the soft boundaries' circles; `count`
+// vertices in all.
+function uploadCurves(gl, report, meshes) {
   const boundaries = boundaryCurves(report);
-  const curves = curveGeometry([...boundaries.cuts, ...boundaries.planes], main);
+  const curves = curveGeometry([...boundaries.cuts, ...boundaries.planes], meshes);
   return {
     count: curves.count,
     cutVertices: 2 * boundaries.cuts.reduce((n, c) => n + c.length, 0),

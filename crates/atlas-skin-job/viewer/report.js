@@ -155,25 +155,38 @@ function boundaryCurves(report) {
   return { cuts, planes };
 }
 
-// Line segments of the curves; each point takes the influences of the nearest mesh vertex
-// (bind space) so the curves follow the skinned surface.
-function curveGeometry(curves, item) {
+// The meshes whose influences the boundary curves take: the main mesh and every other mesh
+// skinned over the same joints in the same order (a character split into several skinned
+// meshes), so that a curve around a part outside the main mesh follows that part.
+function curveMeshes(model) {
+  const joints = model.mainSkin.joints;
+  const sameJoints = (skin) => skin === model.mainSkin || (!skin.rigid && skin.joints.length === joints.length && skin.joints.every((n, j) => n === joints[j]));
+  return model.items.filter((item) => item === model.main || (item.weights0 && sameJoints(item.skin)));
+}
+
+// Line segments of the curves; each point takes the influences of the nearest vertex of
+// `items` (bind space) so the curves follow the skinned surface.
+function curveGeometry(curves, items) {
   const segments = curves.reduce((s, c) => s + c.length, 0);
   const positions = new Float32Array(segments * 6);
   const joints0 = new Uint32Array(segments * 8);
   const weights0 = new Float32Array(segments * 8);
   let s = 0;
   const emit = (p) => {
+    let item = items[0];
     let best = 0;
     let bestDistance = Infinity;
-    for (let v = 0; v < item.vertexCount; v++) {
-      const dx = item.positions[v * 3] - p[0];
-      const dy = item.positions[v * 3 + 1] - p[1];
-      const dz = item.positions[v * 3 + 2] - p[2];
-      const d = dx * dx + dy * dy + dz * dz;
-      if (d < bestDistance) {
-        bestDistance = d;
-        best = v;
+    for (const candidate of items) {
+      for (let v = 0; v < candidate.vertexCount; v++) {
+        const dx = candidate.positions[v * 3] - p[0];
+        const dy = candidate.positions[v * 3 + 1] - p[1];
+        const dz = candidate.positions[v * 3 + 2] - p[2];
+        const d = dx * dx + dy * dy + dz * dz;
+        if (d < bestDistance) {
+          bestDistance = d;
+          best = v;
+          item = candidate;
+        }
       }
     }
     positions.set(p, s * 3);

@@ -50,7 +50,7 @@ function createViewer(model) {
   const treatments = vertexTreatments(model);
   const pieces = treatments ? pieceColours(model, treatments) : { colours: null, counts: new Map() };
   const textures = uploadMeshes(gl, model.items, colours);
-  const curves = uploadCurves(gl, model.report, model.main);
+  const curves = uploadCurves(gl, model.report, curveMeshes(model));
   const tree = jointTree(model.scene, model.mainSkin);
   const skeleton = uploadSkeleton(gl, model.mainSkin.joints.length, tree.bones.length);
   return {
