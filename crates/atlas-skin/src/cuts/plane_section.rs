@@ -106,6 +106,9 @@ pub struct SectionDomain {
     stamp: u32,
     /// The local faces a query crosses, in order (a buffer reused by every query).
     crossed_faces: Vec<u32>,
+    /// The chain being traced: its crossings and faces (buffers reused by every trace).
+    chain_crossings: Vec<EdgeCrossing>,
+    chain_faces: Vec<u32>,
 }
 
 /// Maps from the mesh's vertices, edges and faces to a domain's (0, or 1 + the local
@@ -232,6 +235,8 @@ impl SectionDomain {
             edge_faces,
             stamp: 0,
             crossed_faces: Vec::new(),
+            chain_crossings: Vec::new(),
+            chain_faces: Vec::new(),
         }
     }
 
@@ -320,8 +325,12 @@ impl SectionDomain {
     /// Follows the chain from crossed local edge `start`; `Some` when it closes on `start`.
     fn trace(&mut self, start: u32) -> Option<SectionCurve> {
         self.edge_stamp[start as usize] = self.stamp;
-        let mut crossings = vec![self.crossing(start)];
-        let mut faces = Vec::new();
+        // The chain grows in buffers reused by every trace; a closed one is copied out at
+        // its length (most chains of a query leave the domain and are dropped).
+        let first = self.crossing(start);
+        self.chain_crossings.clear();
+        self.chain_crossings.push(first);
+        self.chain_faces.clear();
         let (mut edge, mut from) = (start, None);
         loop {
             let face = self.face_across(edge, from)?;
@@ -333,15 +342,19 @@ impl SectionDomain {
             if others.next().is_some() {
                 return None;
             }
-            faces.push(self.faces[face as usize]);
+            self.chain_faces.push(self.faces[face as usize]);
             if next == start {
-                return Some(SectionCurve { crossings, faces });
+                return Some(SectionCurve {
+                    crossings: self.chain_crossings.clone(),
+                    faces: self.chain_faces.clone(),
+                });
             }
             if self.edge_stamp[next as usize] == self.stamp {
                 return None;
             }
             self.edge_stamp[next as usize] = self.stamp;
-            crossings.push(self.crossing(next));
+            let crossing = self.crossing(next);
+            self.chain_crossings.push(crossing);
             (edge, from) = (next, Some(face));
         }
     }
