@@ -396,17 +396,28 @@ fn read_reference_weights(
     blocks: &[VertexBlock],
     skeleton_nodes: &[usize],
 ) -> Result<Option<VertexWeights>, IoError> {
-    let mut rows: Vec<Vec<(u32, f32)>> = Vec::new();
+    // Built row by row in place (no list per vertex).
+    let mut weights = VertexWeights {
+        offsets: vec![0],
+        ..VertexWeights::default()
+    };
     let mut any = false;
+    let end_row = |weights: &mut VertexWeights| weights.offsets.push(weights.joints.len() as u32);
     for block in blocks {
         let skin = match block.binding {
             Binding::Skin(skin) => skin,
             Binding::Rigid(joint) => {
-                rows.extend(vec![vec![(joint, 1.0)]; block.count]);
+                for _ in 0..block.count {
+                    weights.joints.push(joint);
+                    weights.weights.push(1.0);
+                    end_row(&mut weights);
+                }
                 continue;
             }
             Binding::Unskinned => {
-                rows.extend(vec![Vec::new(); block.count]);
+                for _ in 0..block.count {
+                    end_row(&mut weights);
+                }
                 continue;
             }
         };
@@ -416,7 +427,9 @@ fn read_reference_weights(
             .map(|node| skeleton_index.get(node).copied().unwrap_or(0))
             .collect();
         let joint_count = skeleton_joint.len();
-        let mut block_rows = vec![Vec::new(); block.count];
+        // Every set read and checked first, in set order (so the first error is the one a
+        // set-by-set reading meets), then each vertex's entries of all sets in set order.
+        let mut sets: Vec<(Vec<u32>, Vec<f32>)> = Vec::new();
         for set in 0.. {
             let location = format!("{}.attributes", block.location);
             let joints = doc.opt_index(block.attributes, &location, &format!("JOINTS_{set}"))?;
@@ -441,30 +454,36 @@ fn read_reference_weights(
                     )));
                 }
             }
-            for (v, row) in block_rows.iter_mut().enumerate() {
-                for k in 4 * v..4 * v + 4 {
-                    let (joint, weight) = (joints_values[k], weight_values[k]);
-                    if !weight.is_finite() || weight < 0.0 {
-                        return Err(doc.error(format!(
-                            "{location}: WEIGHTS_{set} of vertex {v} has weight {weight}"
-                        )));
-                    }
-                    if weight == 0.0 {
-                        continue;
-                    }
-                    if joint as usize >= joint_count {
-                        return Err(doc.error(format!(
-                            "{location}: JOINTS_{set} of vertex {v} is joint {joint}, but the skin \
-                             has {joint_count} joints"
-                        )));
-                    }
-                    row.push((skeleton_joint[joint as usize], weight));
+            for (k, (&joint, &weight)) in joints_values.iter().zip(&weight_values).enumerate() {
+                let v = k / 4;
+                if !weight.is_finite() || weight < 0.0 {
+                    return Err(doc.error(format!(
+                        "{location}: WEIGHTS_{set} of vertex {v} has weight {weight}"
+                    )));
+                }
+                if weight != 0.0 && joint as usize >= joint_count {
+                    return Err(doc.error(format!(
+                        "{location}: JOINTS_{set} of vertex {v} is joint {joint}, but the skin \
+                         has {joint_count} joints"
+                    )));
                 }
             }
+            sets.push((joints_values, weight_values));
         }
-        rows.extend(block_rows);
+        for v in 0..block.count {
+            for (joints_values, weight_values) in &sets {
+                for k in 4 * v..4 * v + 4 {
+                    let (joint, weight) = (joints_values[k], weight_values[k]);
+                    if weight != 0.0 {
+                        weights.joints.push(skeleton_joint[joint as usize]);
+                        weights.weights.push(weight);
+                    }
+                }
+            }
+            end_row(&mut weights);
+        }
     }
-    Ok(any.then(|| VertexWeights::from_rows(rows)))
+    Ok(any.then_some(weights))
 }
 
 #[cfg(test)]

@@ -134,12 +134,16 @@ pub(crate) fn pack_weights(
     let pruned = VertexWeights::from_rows(vertices.map(|v| weights.row(v))).pruned(max_influences);
     let mut joints = vec![vec![0u32; 4 * vertex_count]; sets];
     let mut packed = vec![vec![0f32; 4 * vertex_count]; sets];
+    // Buffers reused by every vertex.
+    let (mut row, mut stored) = (Vec::new(), Vec::new());
     for v in 0..vertex_count {
-        let mut row: Vec<(u32, f32)> = pruned.row(v).collect();
+        row.clear();
+        row.extend(pruned.row(v));
         if row.is_empty() {
             row.push((0, 1.0));
         }
-        for (k, (joint, value)) in stored_weights(row).into_iter().enumerate() {
+        stored_weights(&mut row, &mut stored);
+        for (k, &(joint, value)) in stored.iter().enumerate() {
             let (set, slot) = (k / 4, 4 * v + k % 4);
             joints[set][slot] = joint;
             packed[set][slot] = value;
@@ -151,7 +155,8 @@ pub(crate) fn pack_weights(
     }
 }
 
-/// The float32 values stored for a row of positive weights `w` (not empty).
+/// The float32 values stored for a row of positive weights `w` (not empty), into `stored`
+/// (`row` loses the entries dropped).
 ///
 /// `s_k = fl(w_k / Σ w)` for all but the last entry, and `s_last = fl(1 − Σ_{k<last} s_k)`
 /// (the sum taken in f64), so the float32 sum is 1 within one rounding per addition: the
@@ -159,24 +164,21 @@ pub(crate) fn pack_weights(
 /// value would be 0 (a weight negligible next to the others, or the remainder when the
 /// others round up to 1) is dropped and the rest stored again, so every stored value is
 /// positive; a single entry is stored as 1.
-fn stored_weights(mut row: Vec<(u32, f32)>) -> Vec<(u32, f32)> {
+fn stored_weights(row: &mut Vec<(u32, f32)>, stored: &mut Vec<(u32, f32)>) {
     loop {
         let sum: f64 = row.iter().map(|&(_, w)| w as f64).sum();
         let last = row.len() - 1;
         let mut stored_sum = 0.0f64;
-        let stored: Vec<(u32, f32)> = row
-            .iter()
-            .enumerate()
-            .map(|(k, &(joint, weight))| {
-                let value = if k == last {
-                    (1.0 - stored_sum).max(0.0) as f32
-                } else {
-                    (weight as f64 / sum) as f32
-                };
-                stored_sum += value as f64;
-                (joint, value)
-            })
-            .collect();
+        stored.clear();
+        stored.extend(row.iter().enumerate().map(|(k, &(joint, weight))| {
+            let value = if k == last {
+                (1.0 - stored_sum).max(0.0) as f32
+            } else {
+                (weight as f64 / sum) as f32
+            };
+            stored_sum += value as f64;
+            (joint, value)
+        }));
         match stored
             .iter()
             .position(|&(_, value)| value.is_nan() || value <= 0.0)
@@ -184,7 +186,7 @@ fn stored_weights(mut row: Vec<(u32, f32)>) -> Vec<(u32, f32)> {
             Some(zero) => {
                 row.remove(zero);
             }
-            None => return stored,
+            None => return,
         }
     }
 }

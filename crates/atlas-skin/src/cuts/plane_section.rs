@@ -104,6 +104,11 @@ pub struct SectionDomain {
     edge_faces: Vec<Option<[u32; 2]>>,
     edge_stamp: Vec<u32>,
     stamp: u32,
+    /// The local faces a query crosses, in order (a buffer reused by every query).
+    crossed_faces: Vec<u32>,
+    /// The chain being traced: its crossings and faces (buffers reused by every trace).
+    chain_crossings: Vec<EdgeCrossing>,
+    chain_faces: Vec<u32>,
 }
 
 /// Maps from the mesh's vertices, edges and faces to a domain's (0, or 1 + the local
@@ -229,6 +234,9 @@ impl SectionDomain {
             edge_ends,
             edge_faces,
             stamp: 0,
+            crossed_faces: Vec::new(),
+            chain_crossings: Vec::new(),
+            chain_faces: Vec::new(),
         }
     }
 
@@ -251,16 +259,23 @@ impl SectionDomain {
             self.edge_stamp.fill(0);
             self.stamp = 1;
         }
+        // The crossed faces first (a read-only scan, the hot loop), then the tracing.
+        let mut crossed = std::mem::take(&mut self.crossed_faces);
+        crossed.clear();
+        let side = &self.local_side;
+        crossed.extend(
+            self.local_faces
+                .iter()
+                .enumerate()
+                .filter(|(_, &[a, b, c])| {
+                    // 1 or 2 corners on the positive side.
+                    (side[a as usize] + side[b as usize] + side[c as usize]).wrapping_sub(1) < 2
+                })
+                .map(|(i, _)| i as u32),
+        );
         let mut curves = Vec::new();
-        for i in 0..self.faces.len() {
-            let [a, b, c] = self.local_faces[i];
-            let sides = self.local_side[a as usize]
-                + self.local_side[b as usize]
-                + self.local_side[c as usize];
-            if sides == 0 || sides == 3 {
-                continue;
-            }
-            for e in self.local_face_edges[i] {
+        for &i in &crossed {
+            for e in self.local_face_edges[i as usize] {
                 if self.edge_stamp[e as usize] != self.stamp && self.is_crossed(e) {
                     if let Some(curve) = self.trace(e) {
                         curves.push(curve);
@@ -268,6 +283,7 @@ impl SectionDomain {
                 }
             }
         }
+        self.crossed_faces = crossed;
         curves
     }
 
@@ -309,8 +325,12 @@ impl SectionDomain {
     /// Follows the chain from crossed local edge `start`; `Some` when it closes on `start`.
     fn trace(&mut self, start: u32) -> Option<SectionCurve> {
         self.edge_stamp[start as usize] = self.stamp;
-        let mut crossings = vec![self.crossing(start)];
-        let mut faces = Vec::new();
+        // The chain grows in buffers reused by every trace; a closed one is copied out at
+        // its length (most chains of a query leave the domain and are dropped).
+        let first = self.crossing(start);
+        self.chain_crossings.clear();
+        self.chain_crossings.push(first);
+        self.chain_faces.clear();
         let (mut edge, mut from) = (start, None);
         loop {
             let face = self.face_across(edge, from)?;
@@ -322,15 +342,19 @@ impl SectionDomain {
             if others.next().is_some() {
                 return None;
             }
-            faces.push(self.faces[face as usize]);
+            self.chain_faces.push(self.faces[face as usize]);
             if next == start {
-                return Some(SectionCurve { crossings, faces });
+                return Some(SectionCurve {
+                    crossings: self.chain_crossings.clone(),
+                    faces: self.chain_faces.clone(),
+                });
             }
             if self.edge_stamp[next as usize] == self.stamp {
                 return None;
             }
             self.edge_stamp[next as usize] = self.stamp;
-            crossings.push(self.crossing(next));
+            let crossing = self.crossing(next);
+            self.chain_crossings.push(crossing);
             (edge, from) = (next, Some(face));
         }
     }
