@@ -25,7 +25,7 @@ use crate::cuts::plane_section::{
 };
 use crate::mesh::spatial_index::FaceSpheres;
 use crate::mesh::{SurfaceMesh, Topology};
-use crate::skeleton::nearest_point::SegmentGrid;
+use crate::skeleton::bone_tree::BoneTree;
 use glam::DVec3;
 
 /// How many times the neighbourhood doubles when it holds no closed section around the
@@ -68,13 +68,13 @@ pub struct CutSearch {
     pub enclosing_other_bones: usize,
 }
 
-/// The bones of the skeleton as segments, with a grid for the bones near a point.
+/// The bones of the skeleton as segments, with a tree for the bones near a point.
 #[derive(Debug, Clone)]
 pub struct BoneIndex {
     /// (parent, child) joints of every bone ([`crate::skeleton::bones::joint_pairs`]).
     pairs: Vec<(usize, usize)>,
     segments: Vec<[DVec3; 2]>,
-    grid: SegmentGrid,
+    tree: BoneTree,
 }
 
 impl BoneIndex {
@@ -84,17 +84,17 @@ impl BoneIndex {
             .iter()
             .map(|&(p, c)| [positions[p], positions[c]])
             .collect();
-        let grid = SegmentGrid::new(&segments);
+        let tree = BoneTree::of_segments(&segments);
         Self {
             pairs,
             segments,
-            grid,
+            tree,
         }
     }
 
     /// The bones with neither end at `joint` within `radius` of `point`, in bone order.
     fn near(&self, joint: usize, point: DVec3, radius: f64) -> Vec<[DVec3; 2]> {
-        self.grid
+        self.tree
             .within(point, radius)
             .into_iter()
             .filter(|&k| {

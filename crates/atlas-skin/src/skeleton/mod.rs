@@ -1,10 +1,11 @@
 //! What the method reads from the skeleton beyond the runtime's [`Skeleton`]
-//! (`atlas_skin_runtime`): bone segments and nearest bones ([`bones`]), a hierarchy for
+//! (`atlas_skin_runtime`): bone segments and nearest bones ([`bones`], [`bone_tree`]), a hierarchy for
 //! skeletons with several roots ([`hierarchy`]), the nearest joint ([`nearest_point`]), whether the skeleton sits in the mesh
 //! ([`placement`]).
 //!
 //! [`Skeleton`]: atlas_skin_runtime::Skeleton
 
+pub mod bone_tree;
 pub mod bones;
 pub mod hierarchy;
 pub mod nearest_point;

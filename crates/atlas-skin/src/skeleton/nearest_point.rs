@@ -1,13 +1,12 @@
-//! The nearest of a fixed set of points (the joints) or of segments (the bones) to a query
-//! point, exactly: a uniform grid of a few points (segment midpoints) per cell, searched in
-//! growing shells of cells until the best distance found cannot be beaten by a farther
-//! shell.
+//! The nearest of a fixed set of points (the joints) to a query point, exactly: a uniform
+//! grid of a few points per cell, searched in growing shells of cells until the best
+//! distance found cannot be beaten by a farther shell. (The nearest bone:
+//! [`super::bone_tree`].)
 
-use crate::geometry::point_segment_distance;
 use crate::mesh::spatial_index::CentreGrid;
 use glam::{DVec3, IVec3};
 
-/// Below this many points or segments a scan is cheaper than the grid's shells.
+/// Below this many points a scan is cheaper than the grid's shells.
 const SCAN_BELOW: usize = 64;
 
 /// The points in the cells of a grid (`mesh::spatial_index::CentreGrid`).
@@ -36,94 +35,28 @@ impl PointGrid {
                 .map(distance)
                 .fold(best, f64::min);
         }
-        shells(&self.grid, p, 0.0, f64::INFINITY, &mut |k| {
+        shells(&self.grid, p, &mut |k| {
             best = best.min(distance(k));
             best
         });
         best
-    }
-}
-
-/// Segments [a, b] in the cells of a grid of their midpoints.
-#[derive(Debug, Clone)]
-pub struct SegmentGrid {
-    segments: Vec<[DVec3; 2]>,
-    grid: CentreGrid,
-    /// The largest half length: no point of a segment is farther from its midpoint.
-    reach: f64,
-}
-
-impl SegmentGrid {
-    pub fn new(segments: &[[DVec3; 2]]) -> Self {
-        let middles: Vec<DVec3> = segments.iter().map(|&[a, b]| a.midpoint(b)).collect();
-        Self {
-            segments: segments.to_vec(),
-            grid: CentreGrid::new(&middles),
-            reach: segments
-                .iter()
-                .map(|&[a, b]| 0.5 * a.distance(b))
-                .fold(0.0, f64::max),
-        }
-    }
-
-    /// The smallest [`point_segment_distance`] from `p` to the segments (infinity when there
-    /// are none): the same value as a scan of every segment.
-    pub fn nearest_distance(&self, p: DVec3) -> f64 {
-        let distance = |k: u32| {
-            let [a, b] = self.segments[k as usize];
-            point_segment_distance(p, a, b)
-        };
-        let mut best = f64::INFINITY;
-        if self.segments.len() < SCAN_BELOW {
-            return (0..self.segments.len() as u32)
-                .map(distance)
-                .fold(best, f64::min);
-        }
-        shells(&self.grid, p, self.reach, f64::INFINITY, &mut |k| {
-            best = best.min(distance(k));
-            best
-        });
-        best
-    }
-
-    /// Indices, increasing, of the segments within `radius` of `p`
-    /// ([`point_segment_distance`] ≤ `radius`): the same as a scan of every segment.
-    pub fn within(&self, p: DVec3, radius: f64) -> Vec<u32> {
-        let near = |k: u32| {
-            let [a, b] = self.segments[k as usize];
-            point_segment_distance(p, a, b) <= radius
-        };
-        if self.segments.len() < SCAN_BELOW {
-            return (0..self.segments.len() as u32)
-                .filter(|&k| near(k))
-                .collect();
-        }
-        let mut found = Vec::new();
-        shells(&self.grid, p, self.reach, radius, &mut |k| {
-            if near(k) {
-                found.push(k);
-            }
-            radius
-        });
-        found.sort_unstable();
-        found
     }
 }
 
 /// Visits the items of `grid` in shells of cells around `p` until none can be nearer than
-/// the distance `visit(item)` returns (the best so far), nor than `limit`. Shell r holds the cells at Chebyshev
-/// distance r from p's (clamped) cell; an item in shell r has its grid point at least
-/// (r − 1) cells from p (r cells along an axis where p lies outside the grid) and at least
-/// as far as p lies outside the grid, hence lies itself at least that minus `reach` away.
-fn shells(grid: &CentreGrid, p: DVec3, reach: f64, limit: f64, visit: &mut impl FnMut(u32) -> f64) {
-    let mut best = limit;
+/// the distance `visit(item)` returns (the best so far). Shell r holds the cells at
+/// Chebyshev distance r from p's (clamped) cell; an item in shell r lies at least (r − 1)
+/// cells from p (r cells along an axis where p lies outside the grid) and at least as far
+/// as p lies outside the grid.
+fn shells(grid: &CentreGrid, p: DVec3, visit: &mut impl FnMut(u32) -> f64) {
+    let mut best = f64::INFINITY;
     let centre = grid.cell_of(p);
     let outside = (grid.origin - p)
         .max(p - (grid.origin + grid.dims.as_dvec3() * grid.cell))
         .max(DVec3::ZERO)
         .length();
     for r in 0..=grid.dims.max_element() {
-        let bound = outside.max((r - 1).max(0) as f64 * grid.cell) - reach;
+        let bound = outside.max((r - 1).max(0) as f64 * grid.cell);
         if bound > best {
             break;
         }
@@ -180,40 +113,6 @@ mod tests {
                     .map(|q| q.distance(p))
                     .fold(f64::INFINITY, f64::min);
                 assert_eq!(grid.nearest_distance(p), scanned);
-            }
-        }
-    }
-
-    /// Short, long, crossing and point segments, queried inside and far outside their box:
-    /// the same distance as a scan of every segment.
-    #[test]
-    fn grid_gives_the_scanned_nearest_segment_distance() {
-        let mut rng = SplitMix64::new(4);
-        let mut random =
-            |scale: f64| DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64()) * scale;
-        for (count, length) in [(0, 0.1), (1, 0.0), (50, 0.05), (300, 0.3), (40, 3.0)] {
-            let segments: Vec<[DVec3; 2]> = (0..count)
-                .map(|_| {
-                    let a = random(2.0);
-                    [a, a + (random(2.0) - DVec3::ONE) * length]
-                })
-                .collect();
-            let grid = SegmentGrid::new(&segments);
-            for _ in 0..300 {
-                let p = random(8.0) - DVec3::splat(2.0);
-                let scanned = segments
-                    .iter()
-                    .map(|&[a, b]| point_segment_distance(p, a, b))
-                    .fold(f64::INFINITY, f64::min);
-                assert_eq!(grid.nearest_distance(p), scanned);
-                let radius = 0.5;
-                let near: Vec<u32> = (0..segments.len() as u32)
-                    .filter(|&k| {
-                        let [a, b] = segments[k as usize];
-                        point_segment_distance(p, a, b) <= radius
-                    })
-                    .collect();
-                assert_eq!(grid.within(p, radius), near);
             }
         }
     }

@@ -9,6 +9,7 @@ use super::surface_weights::SurfaceWeights;
 use crate::decomposition::Decomposition;
 use crate::rows::{Rows, PAR_CHUNK};
 use atlas_skin_runtime::Skeleton;
+use std::collections::HashMap;
 
 /// The joints of one region as a tree for step 3: node 0 is the bound joint, node i > 0
 /// the soft boundary `softs[i − 1]`; nodes listed parents first.
@@ -21,6 +22,26 @@ pub struct RegionTree {
     /// Parent node of every node (0 for the root).
     parents: Vec<usize>,
     order: Vec<usize>,
+    /// The position of every node in `order`.
+    rank: Vec<usize>,
+}
+
+impl RegionTree {
+    /// Sets `order` (breadth first from the root, children in node order) and `rank` from
+    /// `children`.
+    fn list_in_order(&mut self) {
+        self.order = vec![0];
+        let mut i = 0;
+        while i < self.order.len() {
+            let node = self.order[i];
+            self.order.extend(self.children[node].iter().copied());
+            i += 1;
+        }
+        self.rank = vec![0; self.joints.len()];
+        for (rank, &node) in self.order.iter().enumerate() {
+            self.rank[node] = rank;
+        }
+    }
 }
 
 pub fn region_trees(
@@ -48,21 +69,20 @@ pub fn region_trees(
             }
             tree.children = vec![Vec::new(); tree.joints.len()];
             tree.parents = vec![0; tree.joints.len()];
+            // The first node of each joint.
+            let mut node_of_joint = HashMap::new();
+            for (node, &j) in tree.joints.iter().enumerate() {
+                node_of_joint.entry(j as usize).or_insert(node);
+            }
             for node in 1..tree.joints.len() {
                 let parent = skeleton
                     .ancestors(tree.joints[node] as usize)
-                    .find_map(|a| tree.joints.iter().position(|&j| j as usize == a))
+                    .find_map(|a| node_of_joint.get(&a).copied())
                     .unwrap_or(0);
                 tree.children[parent].push(node);
                 tree.parents[node] = parent;
             }
-            tree.order = vec![0];
-            let mut i = 0;
-            while i < tree.order.len() {
-                let node = tree.order[i];
-                tree.order.extend(tree.children[node].iter().copied());
-                i += 1;
-            }
+            tree.list_in_order();
             tree
         })
         .collect()
@@ -79,12 +99,26 @@ fn patch_shares(patches: &[Patch], vertex_count: usize) -> Rows<(u32, f64)> {
     Rows::group(vertex_count, entries)
 }
 
+/// Per vertex, the (soft side, κ_c, π_c) of every soft side reaching it.
+fn soft_reaches(softs: &[SoftSide], vertex_count: usize) -> Rows<(u32, f64, f64)> {
+    let entries = softs.iter().enumerate().flat_map(|(s, soft)| {
+        soft.reached()
+            .iter()
+            .map(move |&(v, kappa, beyond)| (v as usize, (s as u32, kappa, beyond)))
+    });
+    Rows::group(vertex_count, entries)
+}
+
 /// Per-chunk working memory of [`blend_vertices`].
 #[derive(Default)]
 struct BlendScratch {
     depths: Vec<f64>,
     region_weights: Vec<f64>,
+    /// One mass per node of the largest region tree, 0 between vertices.
     mass: Vec<f64>,
+    /// The (node, s_c) of the soft sides of one region at one vertex with s_c > 0.
+    shares: Vec<(usize, f64)>,
+    parents: Vec<usize>,
 }
 
 /// Steps 2 and 3 for every vertex.
@@ -97,6 +131,15 @@ pub fn blend_vertices(
     blend: Blend,
 ) -> SurfaceWeights {
     let patch_shares = patch_shares(patches, decomposition.surface.vertex_count());
+    let soft_reaches = soft_reaches(softs, decomposition.surface.vertex_count());
+    // The node of every soft side in its region's tree.
+    let mut node_of_soft = vec![None; softs.len()];
+    for tree in trees {
+        for (i, &s) in tree.softs.iter().enumerate() {
+            node_of_soft[s] = Some(i + 1);
+        }
+    }
+    let largest_tree = trees.iter().map(|t| t.joints.len()).max().unwrap_or(0);
     let positions = &decomposition.surface.positions;
     let rows = Rows::par_build(
         positions.len(),
@@ -108,16 +151,22 @@ pub fn blend_vertices(
             scratch.region_weights.clear();
             scratch.region_weights.resize(regions.len(), 0.0);
             blend_regions(blend, &scratch.depths, &mut scratch.region_weights);
+            scratch.mass.resize(largest_tree, 0.0);
             let start = out.len();
             for (&(r, _), &omega) in regions.iter().zip(&scratch.region_weights) {
                 let tree = &trees[r as usize];
+                scratch.shares.clear();
+                scratch.shares.extend(soft_reaches.row(v).iter().filter_map(
+                    |&(s, kappa, beyond)| {
+                        let soft = &softs[s as usize];
+                        let node = node_of_soft[s as usize].filter(|_| soft.region == r)?;
+                        let share = soft.share(positions[v], kappa, beyond);
+                        (share > 0.0).then_some((node, share))
+                    },
+                ));
+                scratch.shares.sort_unstable_by_key(|&(node, _)| node);
                 let mass = &mut scratch.mass;
-                share_along_chain(
-                    tree,
-                    |c| softs[tree.softs[c - 1]].share(v, positions[v]),
-                    omega,
-                    mass,
-                );
+                share_along_chain(tree, &scratch.shares, omega, mass, &mut scratch.parents);
                 // Step 3b: the leaf patches take their shares of every joint's mass alike.
                 let in_region = patch_shares
                     .row(v)
@@ -127,12 +176,12 @@ pub fn blend_vertices(
                 let keep = 1.0 - patch_total.min(1.0);
                 let patch_masses = in_region
                     .map(|&(k, p)| (patches[k as usize].joint, omega * p / patch_total.max(1.0)));
-                let joint_masses = tree
-                    .joints
-                    .iter()
-                    .zip(mass.iter())
-                    .map(|(&j, &m)| (j, m * keep));
-                for (joint, m) in joint_masses.chain(patch_masses) {
+                // The nodes with mass: the root and those with shares, in node order.
+                let nodes = std::iter::once(0).chain(scratch.shares.iter().map(|&(c, _)| c));
+                let joint_masses: Vec<(u32, f64)> = nodes
+                    .map(|c| (tree.joints[c], std::mem::take(&mut mass[c]) * keep))
+                    .collect();
+                for (joint, m) in joint_masses.into_iter().chain(patch_masses) {
                     if m <= 0.0 {
                         continue;
                     }
@@ -153,36 +202,132 @@ pub fn blend_vertices(
 }
 
 /// Step 3 at one vertex: the region's weight `omega` shared among the joints of its `tree`
-/// (module documentation of [`crate::weights`]); `share(c)` is s_c of node c > 0. Fills
-/// `mass` with one mass per node, non-negative and summing to `omega`.
+/// (module documentation of [`crate::weights`]); `shares` holds (c, s_c) for the nodes
+/// c > 0 with s_c > 0, by increasing node (s_c is 0 at the others). Sets `mass[0]` and
+/// `mass[c]` of those nodes, non-negative and summing to `omega`; every other entry of
+/// `mass` (at least one per node) must be 0 and stays 0. `parents`: working memory.
+///
+/// Only the parents of nodes with shares move mass, in the tree's order (a node whose
+/// children have no share passes its mass on unchanged): the cost follows the shares at
+/// the vertex, not the size of the tree (one region with 10,000 soft joints).
 fn share_along_chain(
     tree: &RegionTree,
-    share: impl Fn(usize) -> f64,
+    shares: &[(usize, f64)],
     omega: f64,
-    mass: &mut Vec<f64>,
+    mass: &mut [f64],
+    parents: &mut Vec<usize>,
 ) {
-    mass.clear();
-    mass.resize(tree.joints.len(), 0.0);
     mass[0] = omega;
-    for &node in &tree.order {
-        let total: f64 = tree.children[node].iter().map(|&c| share(c)).sum();
+    parents.clear();
+    parents.extend(shares.iter().map(|&(c, _)| tree.parents[c]));
+    parents.sort_unstable_by_key(|&node| tree.rank[node]);
+    parents.dedup();
+    for &node in parents.iter() {
+        let children = shares.iter().filter(|&&(c, _)| tree.parents[c] == node);
+        let total: f64 = children.clone().map(|&(_, share)| share).sum();
         if total <= 0.0 {
             continue;
         }
-        // The children take their shares of the mass of the whole chain from the root to
-        // `node`.
-        let mut pool = 0.0;
-        let mut a = node;
-        loop {
-            pool += mass[a];
-            mass[a] *= 1.0 - total.min(1.0);
-            if a == 0 {
-                break;
-            }
-            a = tree.parents[a];
+        let pool = take_pool(tree, node, total, mass);
+        for &(c, share) in children {
+            mass[c] = pool * share / total.max(1.0);
         }
-        for &c in &tree.children[node] {
-            mass[c] = pool * share(c) / total.max(1.0);
+    }
+}
+
+/// The mass the children of `node` share, whose shares sum to `total`: the mass of the
+/// whole chain from the root to `node`, each of whose masses keeps 1 − min(total, 1).
+fn take_pool(tree: &RegionTree, node: usize, total: f64, mass: &mut [f64]) -> f64 {
+    let mut pool = 0.0;
+    let mut a = node;
+    loop {
+        pool += mass[a];
+        mass[a] *= 1.0 - total.min(1.0);
+        if a == 0 {
+            return pool;
+        }
+        a = tree.parents[a];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use atlas_skin_runtime::random_pose::SplitMix64;
+
+    /// Step 3 by its definition: every node of the tree in order, with every child's share
+    /// (0 included).
+    fn reference_masses(tree: &RegionTree, share: impl Fn(usize) -> f64, omega: f64) -> Vec<f64> {
+        let mut mass = vec![0.0; tree.joints.len()];
+        mass[0] = omega;
+        for &node in &tree.order {
+            let total: f64 = tree.children[node].iter().map(|&c| share(c)).sum();
+            if total <= 0.0 {
+                continue;
+            }
+            let pool = take_pool(tree, node, total, &mut mass);
+            for &c in &tree.children[node] {
+                mass[c] = pool * share(c) / total.max(1.0);
+            }
+        }
+        mass
+    }
+
+    /// Random trees (chains, fans of siblings, mixtures) and random shares, most of them 0:
+    /// the same masses, to the bit, as the reference, and the working masses left at 0.
+    #[test]
+    fn sparse_chain_sharing_gives_the_reference_masses() {
+        let mut rng = SplitMix64::new(5);
+        for case in 0..200 {
+            let n = 1 + (rng.next_f64() * 40.0) as usize;
+            let mut tree = RegionTree {
+                joints: (0..n as u32).collect(),
+                softs: (0..n.saturating_sub(1)).collect(),
+                children: vec![Vec::new(); n],
+                parents: vec![0; n],
+                ..RegionTree::default()
+            };
+            for node in 1..n {
+                let parent = match case % 3 {
+                    0 => node - 1,
+                    1 => 0,
+                    _ => (rng.next_f64() * node as f64) as usize,
+                };
+                tree.parents[node] = parent;
+                tree.children[parent].push(node);
+            }
+            tree.list_in_order();
+            let all_shares: Vec<f64> = (0..n)
+                .map(|c| {
+                    let roll = rng.next_f64();
+                    if c == 0 || roll < 0.6 {
+                        0.0
+                    } else if roll < 0.7 {
+                        1.0
+                    } else {
+                        rng.next_f64() * 0.8
+                    }
+                })
+                .collect();
+            let omega = rng.next_f64();
+            let expected = reference_masses(&tree, |c| all_shares[c], omega);
+            let shares: Vec<(usize, f64)> = (1..n)
+                .filter(|&c| all_shares[c] > 0.0)
+                .map(|c| (c, all_shares[c]))
+                .collect();
+            let mut mass = vec![0.0; n + 3];
+            share_along_chain(&tree, &shares, omega, &mut mass, &mut Vec::new());
+            for c in 0..n {
+                assert_eq!(
+                    mass[c].to_bits(),
+                    expected[c].to_bits(),
+                    "case {case}, node {c}"
+                );
+            }
+            // The masses of nodes without share are 0, as the caller's reset assumes.
+            for (c, &m) in mass.iter().enumerate() {
+                assert!(c == 0 || m == 0.0 || all_shares.get(c).is_some_and(|&s| s > 0.0));
+            }
         }
     }
 }

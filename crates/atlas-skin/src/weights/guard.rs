@@ -20,11 +20,11 @@
 
 use super::surface_weights::SurfaceWeights;
 use crate::decomposition::Decomposition;
-use crate::geometry::{point_segment_distance, segment_parameter};
+use crate::geometry::segment_parameter;
 use crate::mesh::FaceSpheres;
 use crate::rows::{Rows, PAR_CHUNK};
+use crate::skeleton::bone_tree::{BoneTree, Keys, Split};
 use crate::skeleton::bones::bone_segments;
-use crate::skeleton::nearest_point::SegmentGrid;
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
 
@@ -56,26 +56,21 @@ pub fn guard_far_bones(
         return 0;
     }
     let floor = NEAR_FLOOR * surface.diagonal();
-    // Each joint's segments, and a grid of all of them for the nearest (linear in the
-    // joints where bones are short, instead of a scan of every bone per vertex).
-    let mut segments_of_joint = vec![Vec::new(); skeleton.len()];
-    for &(j, a, b) in &segments {
-        segments_of_joint[j as usize].push([a, b]);
-    }
-    let all_segments: Vec<[DVec3; 2]> = segments.iter().map(|&(_, a, b)| [a, b]).collect();
-    let segment_grid = SegmentGrid::new(&all_segments);
+    // All the segments in one tree for the nearest, and keyed by joint for each joint's
+    // nearest (a descent each, instead of a scan of every bone, or of the hundreds of child
+    // bones of one joint, per vertex).
+    let bone_tree =
+        BoneTree::of_segments(&segments.iter().map(|&(_, a, b)| [a, b]).collect::<Vec<_>>());
+    let joint_tree = BoneTree::new(segments.iter().copied(), Split::Keys);
     let joint_distance = |p: DVec3, joint: u32| {
-        segments_of_joint[joint as usize]
-            .iter()
-            .map(|&[a, b]| point_segment_distance(p, a, b))
-            .fold(f64::INFINITY, f64::min)
+        joint_tree.nearest_distance(p, Keys::Inside(joint, joint + 1), |_, _| true)
     };
     // Vertices with a joint that is far even from the nearest bone by straight line: only
     // they need the line-of-sight test.
     let suspects: Vec<usize> = (0..weights.vertex_count())
         .filter(|&v| {
             let p = surface.positions[v];
-            let nearest = segment_grid.nearest_distance(p);
+            let nearest = bone_tree.nearest(p);
             let limit = FAR_BONE_RATIO * nearest.max(floor);
             weights.row(v).any(|(j, _)| joint_distance(p, j) > limit)
         })

@@ -132,21 +132,18 @@ pub fn compute_weights(
     let bands = vertex_bands(&overlaps.bands, vertex_count);
     let related = related_regions(decomposition, overlaps, &bands);
     let region_vertices = region_vertices(decomposition, &related);
-    let softs = soft_sides(
-        decomposition,
-        skeleton,
-        overlaps,
-        &related,
-        &region_vertices,
-    );
+    let softs = soft_sides(decomposition, skeleton, overlaps, &related);
+    let mut has_soft_side = vec![false; skeleton.len()];
+    for s in &softs {
+        has_soft_side[s.joint as usize] = true;
+    }
     let active: Vec<bool> = decomposition
         .joints
         .iter()
         .enumerate()
         .map(|(j, decision)| {
             decision.boundary.is_some_and(|k| {
-                decomposition.boundaries[k as usize].kind != BoundaryKind::Soft
-                    || softs.iter().any(|s| s.joint as usize == j)
+                decomposition.boundaries[k as usize].kind != BoundaryKind::Soft || has_soft_side[j]
             })
         })
         .collect();
@@ -158,7 +155,7 @@ pub fn compute_weights(
     counts.inactive_soft_joints = decomposition
         .boundaries
         .iter()
-        .filter(|b| b.kind == BoundaryKind::Soft && !softs.iter().any(|s| s.joint == b.joint))
+        .filter(|b| b.kind == BoundaryKind::Soft && !has_soft_side[b.joint as usize])
         .map(|b| b.joint)
         .collect();
     Ok((weights, counts))

@@ -7,152 +7,236 @@
 //! bones at the joint), κ(p) = β(clamp(1 − (a − b) / w, 0, 1)), and 1 when the region has
 //! no other bone: 1 wherever the own bones are the nearer, falling to 0 within one
 //! half-width w past the surface equidistant from both.
+//!
+//! The bones are indexed once for every joint ([`OwnershipBones`]): the joints numbered in
+//! depth-first order, so that the bones of a joint's subtree are one range of numbers, in
+//! hierarchies of bone boxes ([`crate::skeleton::bone_tree`]): one over every bone, one per
+//! region, one per group of the `beyond` factor. A distance costs a descent of a tree, not a
+//! scan of the region's bones (10,000 siblings of one root: 10,000 collinear bones in one
+//! region).
 
 use crate::decomposition::JointDecision;
+use crate::skeleton::bone_tree::{BoneTree, Keys, Split};
 use crate::weights::blend::beta;
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
+use std::collections::HashMap;
 
-/// The bones that decide κ for one joint of a region.
-pub(crate) struct Ownership {
-    /// The joint's own bones: its child bones and every bone below them.
-    own_bones: Vec<Segment>,
-    /// The other bones of the region (neither the joint's own nor its upper bone).
-    other_bones: Vec<Segment>,
-    half_width: f64,
+/// The bones of a skeleton, indexed for the κ of any joint and region.
+pub(crate) struct OwnershipBones {
+    /// #J depth-first position of every joint: the joints below j (j included) are the
+    /// positions `order[j]..subtree_end[j]`.
+    order: Vec<u32>,
+    subtree_end: Vec<u32>,
+    positions: Vec<DVec3>,
+    parents: Vec<Option<usize>>,
+    /// Every bone keyed by its joint's depth-first position, split by keys.
+    all: BoneTree,
+    /// Per region: the bones of the joints whose bone lies in it, keyed likewise.
+    regions: HashMap<u32, BoneTree>,
 }
 
-/// A bone [a, b], prepared for many distance queries.
-#[derive(Debug, Clone, Copy)]
-struct Segment {
-    start: DVec3,
-    along: DVec3,
-    /// 1 / |b − a|², 0 for a point.
-    inverse_length_squared: f64,
-    /// Midpoint and half length: no point of the segment is farther from the midpoint.
-    middle: DVec3,
-    half_length: f64,
-}
-
-impl Segment {
-    fn new(start: DVec3, end: DVec3) -> Self {
-        let along = end - start;
-        let length_squared = along.length_squared();
-        Self {
-            start,
-            along,
-            inverse_length_squared: if length_squared > 0.0 {
-                1.0 / length_squared
-            } else {
-                0.0
-            },
-            middle: start + 0.5 * along,
-            half_length: 0.5 * length_squared.sqrt(),
-        }
-    }
-
-    /// Squared distance from `p` to the segment (the same point as
-    /// [`crate::skeleton::bones::point_segment_distance`]).
-    fn distance_squared(&self, p: DVec3) -> f64 {
-        let offset = p - self.start;
-        let t = (offset.dot(self.along) * self.inverse_length_squared).clamp(0.0, 1.0);
-        (offset - self.along * t).length_squared()
-    }
-}
-
-impl Ownership {
-    /// The bones κ compares for `joint` in `region`, as (start, end) segments of
-    /// `segments` ([`crate::skeleton::bones::bone_segments`]): its own bones, those of the joint and the joints
-    /// below it, and the other bones of the region, those of every other joint whose
-    /// decision lies in the region except the parent's bones ending at the joint's
-    /// position (its upper bone).
+impl OwnershipBones {
+    /// The index of `segments` ([`crate::skeleton::bones::bone_segments`] of `skeleton`),
+    /// with the regions of `decisions`.
     pub(crate) fn new(
         skeleton: &Skeleton,
         decisions: &[JointDecision],
         segments: &[(u32, DVec3, DVec3)],
+    ) -> Self {
+        let (order, subtree_end) = depth_first_ranges(skeleton);
+        let keyed = |&(j, start, end): &(u32, DVec3, DVec3)| (order[j as usize], start, end);
+        let mut by_region: HashMap<u32, Vec<(u32, DVec3, DVec3)>> = HashMap::new();
+        for segment in segments {
+            if let Some(region) = decisions[segment.0 as usize].region {
+                by_region.entry(region).or_default().push(keyed(segment));
+            }
+        }
+        Self {
+            all: BoneTree::new(segments.iter().map(keyed), Split::Keys),
+            regions: by_region
+                .into_iter()
+                .map(|(region, bones)| (region, BoneTree::new(bones, Split::Space)))
+                .collect(),
+            positions: skeleton
+                .bind_positions()
+                .iter()
+                .map(|p| p.as_dvec3())
+                .collect(),
+            parents: (0..skeleton.len()).map(|j| skeleton.parent(j)).collect(),
+            order,
+            subtree_end,
+        }
+    }
+}
+
+/// The depth-first position of every joint of `skeleton` and the end of its subtree's
+/// positions (roots in index order, children in index order).
+fn depth_first_ranges(skeleton: &Skeleton) -> (Vec<u32>, Vec<u32>) {
+    let children = skeleton.children();
+    let (mut order, mut end) = (vec![0u32; skeleton.len()], vec![0u32; skeleton.len()]);
+    let mut next = 0u32;
+    // (joint, whether its subtree is finished)
+    let mut stack: Vec<(usize, bool)> = (0..skeleton.len())
+        .rev()
+        .filter(|&j| skeleton.parent(j).is_none())
+        .map(|j| (j, false))
+        .collect();
+    while let Some((j, finished)) = stack.pop() {
+        if finished {
+            end[j] = next;
+            continue;
+        }
+        order[j] = next;
+        next += 1;
+        stack.push((j, true));
+        stack.extend(children[j].iter().rev().map(|&c| (c, false)));
+    }
+    (order, end)
+}
+
+/// For the `beyond` factor of joints with a boundary of their own (`handled`): the bones of
+/// every joint below such a joint h with no other handled joint between them, per h.
+pub(crate) struct FreeBones {
+    groups: HashMap<u32, BoneTree>,
+}
+
+impl FreeBones {
+    pub(crate) fn new(
+        skeleton: &Skeleton,
+        segments: &[(u32, DVec3, DVec3)],
+        handled: &[bool],
+    ) -> Self {
+        // The nearest handled joint at or above each joint.
+        let mut handler: Vec<Option<usize>> = vec![None; skeleton.len()];
+        for j in skeleton.topological_order() {
+            handler[j] = if handled[j] {
+                Some(j)
+            } else {
+                skeleton.parent(j).and_then(|p| handler[p])
+            };
+        }
+        let mut groups: HashMap<u32, Vec<(u32, DVec3, DVec3)>> = HashMap::new();
+        for &(j, start, end) in segments {
+            if let Some(h) = handler[j as usize].filter(|&h| h != j as usize) {
+                groups.entry(h as u32).or_default().push((j, start, end));
+            }
+        }
+        Self {
+            groups: groups
+                .into_iter()
+                .map(|(h, bones)| (h, BoneTree::new(bones, Split::Space)))
+                .collect(),
+        }
+    }
+}
+
+/// Some bones of an [`OwnershipBones`]: those of `tree` whose keys `keys` admits, except
+/// those keyed `upper.0` that end at `upper.1` (a joint's upper bones).
+#[derive(Clone, Copy)]
+struct BoneSet<'a> {
+    tree: Option<&'a BoneTree>,
+    keys: Keys,
+    upper: Option<(u32, DVec3)>,
+}
+
+impl BoneSet<'_> {
+    const NONE: Self = Self {
+        tree: None,
+        keys: Keys::ALL,
+        upper: None,
+    };
+
+    fn nearest_distance(&self, p: DVec3) -> f64 {
+        self.tree.map_or(f64::INFINITY, |tree| {
+            tree.nearest_distance(p, self.keys, |key, end| self.upper != Some((key, end)))
+        })
+    }
+}
+
+/// The bones that decide κ for one joint of a region.
+pub(crate) struct Ownership<'a> {
+    bones: &'a OwnershipBones,
+    /// The joint's own bones: its child bones and every bone below them.
+    own: BoneSet<'a>,
+    /// The other bones of the region (neither the joint's own nor its upper bone), and for
+    /// [`Ownership::beyond`] the joint's child bones.
+    other: [BoneSet<'a>; 2],
+    half_width: f64,
+}
+
+impl<'a> Ownership<'a> {
+    /// The bones κ compares for `joint` in `region`: its own bones, those of the joint and
+    /// the joints below it, and the other bones of the region, those of every other joint
+    /// whose decision lies in the region except the parent's bones ending at the joint's
+    /// position (its upper bone).
+    pub(crate) fn new(
+        bones: &'a OwnershipBones,
         joint: usize,
         region: u32,
         half_width: f64,
     ) -> Self {
-        let below_joint = |j: usize| j == joint || skeleton.ancestors(j).any(|a| a == joint);
-        let joint_position = skeleton.bind_positions()[joint].as_dvec3();
-        let upper_parent = skeleton.parent(joint);
-        let mut ownership = Self {
-            own_bones: Vec::new(),
-            other_bones: Vec::new(),
+        let below = (bones.order[joint], bones.subtree_end[joint]);
+        let upper = bones.parents[joint].map(|p| (bones.order[p], bones.positions[joint]));
+        Self {
+            bones,
+            own: BoneSet {
+                tree: Some(&bones.all),
+                keys: Keys::Inside(below.0, below.1),
+                upper: None,
+            },
+            other: [
+                BoneSet {
+                    tree: bones.regions.get(&region),
+                    keys: Keys::Outside(below.0, below.1),
+                    upper,
+                },
+                BoneSet::NONE,
+            ],
             half_width,
-        };
-        for &(j, start, end) in segments {
-            let j = j as usize;
-            if below_joint(j) {
-                ownership.own_bones.push(Segment::new(start, end));
-            } else if decisions[j].region == Some(region)
-                && !(upper_parent == Some(j) && end == joint_position)
-            {
-                ownership.other_bones.push(Segment::new(start, end));
-            }
         }
-        ownership
     }
 
     /// The factor that carries a soft joint's part past the far edge of its plane's band
     /// (weights, step 3): the same formula as κ with, as own bones, the bones of the
-    /// joint's descendants that no other soft boundary of the region takes
-    /// (`handled[d]` true: such a joint's bones and those below it are left out), and as
-    /// other bones, the joint's own child bones and the other bones of `self`. It is 1
-    /// where such a descendant bone is the nearest: a chin below the plane of the neck
-    /// joint above it, nearest to a jaw bone that has no boundary of its own.
-    pub(crate) fn beyond(
-        &self,
-        skeleton: &Skeleton,
-        segments: &[(u32, DVec3, DVec3)],
-        joint: usize,
-        handled: &[bool],
-    ) -> Self {
-        // Whether j lies strictly below `joint` with no handled joint on the way.
-        let free_descendant = |j: usize| {
-            j != joint
-                && std::iter::once(j)
-                    .chain(skeleton.ancestors(j))
-                    .find(|&a| a == joint || handled[a])
-                    == Some(joint)
-        };
-        let mut beyond = Self {
-            own_bones: Vec::new(),
-            other_bones: self.other_bones.clone(),
+    /// joint's descendants that no other soft boundary of the region takes (`free`: the
+    /// joints below a joint with a boundary of its own, such as `joint`, and their bones
+    /// are left out), and as other bones, the joint's own child bones and the other bones
+    /// of `self`. It is 1 where such a descendant bone is the nearest: a chin below the
+    /// plane of the neck joint above it, nearest to a jaw bone that has no boundary of its
+    /// own. `joint` must be one of the handled joints `free` was built with.
+    pub(crate) fn beyond(&self, free: &'a FreeBones, joint: usize) -> Self {
+        let key = self.bones.order[joint];
+        Self {
+            bones: self.bones,
+            own: BoneSet {
+                tree: free.groups.get(&(joint as u32)),
+                ..BoneSet::NONE
+            },
+            other: [
+                self.other[0],
+                BoneSet {
+                    tree: Some(&self.bones.all),
+                    keys: Keys::Inside(key, key + 1),
+                    upper: None,
+                },
+            ],
             half_width: self.half_width,
-        };
-        for &(j, start, end) in segments {
-            if j as usize == joint {
-                beyond.other_bones.push(Segment::new(start, end));
-            } else if free_descendant(j as usize) {
-                beyond.own_bones.push(Segment::new(start, end));
-            }
         }
-        beyond
     }
 
     /// κ(p) = β(clamp(1 − (a − b) / w, 0, 1)), a and b the distances from p to the
     /// nearest own and other bone (1 without other bones, 0 without own bones).
     pub(crate) fn at(&self, position: DVec3) -> f64 {
-        // The nearest bone's distance; a bone whose bounding sphere lies farther than the
-        // best distance so far cannot be nearer and is skipped.
-        let nearest = |bones: &[Segment]| {
-            let mut best = f64::INFINITY;
-            for bone in bones {
-                let reach = best + bone.half_length;
-                if position.distance_squared(bone.middle) >= reach * reach {
-                    continue;
-                }
-                best = best.min(bone.distance_squared(position).sqrt());
-            }
-            best
-        };
-        let own = nearest(&self.own_bones);
+        let own = self.own.nearest_distance(position);
         if own == f64::INFINITY {
             return 0.0;
         }
-        let other = nearest(&self.other_bones);
+        let other = self
+            .other
+            .iter()
+            .map(|bones| bones.nearest_distance(position))
+            .fold(f64::INFINITY, f64::min);
         if other == f64::INFINITY {
             return 1.0;
         }
@@ -164,10 +248,67 @@ impl Ownership {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::decomposition::JointStatus;
     use crate::geometry::point_segment_distance;
+    use crate::skeleton::bones::bone_segments;
     use atlas_skin_runtime::random_pose::SplitMix64;
+    use atlas_skin_runtime::NO_PARENT;
+    use glam::Vec3;
 
-    /// κ by the formula with plain point–segment distances, no pruning.
+    type Bones = Vec<[DVec3; 2]>;
+
+    /// κ's bones for `joint` in `region` by their definition, each joint's ancestors walked:
+    /// (own, other).
+    fn reference_bones(
+        skeleton: &Skeleton,
+        decisions: &[JointDecision],
+        segments: &[(u32, DVec3, DVec3)],
+        joint: usize,
+        region: u32,
+    ) -> (Bones, Bones) {
+        let below_joint = |j: usize| j == joint || skeleton.ancestors(j).any(|a| a == joint);
+        let joint_position = skeleton.bind_positions()[joint].as_dvec3();
+        let (mut own, mut other) = (Vec::new(), Vec::new());
+        for &(j, start, end) in segments {
+            let j = j as usize;
+            if below_joint(j) {
+                own.push([start, end]);
+            } else if decisions[j].region == Some(region)
+                && !(skeleton.parent(joint) == Some(j) && end == joint_position)
+            {
+                other.push([start, end]);
+            }
+        }
+        (own, other)
+    }
+
+    /// The bones of [`Ownership::beyond`] by their definition, from the reference `other`.
+    fn reference_beyond(
+        skeleton: &Skeleton,
+        segments: &[(u32, DVec3, DVec3)],
+        joint: usize,
+        handled: &[bool],
+        other: &Bones,
+    ) -> (Bones, Bones) {
+        let free_descendant = |j: usize| {
+            j != joint
+                && std::iter::once(j)
+                    .chain(skeleton.ancestors(j))
+                    .find(|&a| a == joint || handled[a])
+                    == Some(joint)
+        };
+        let (mut own, mut beyond_other) = (Vec::new(), other.clone());
+        for &(j, start, end) in segments {
+            if j as usize == joint {
+                beyond_other.push([start, end]);
+            } else if free_descendant(j as usize) {
+                own.push([start, end]);
+            }
+        }
+        (own, beyond_other)
+    }
+
+    /// κ by the formula with plain point–segment distances, every bone scanned.
     fn reference_kappa(own: &[[DVec3; 2]], other: &[[DVec3; 2]], w: f64, p: DVec3) -> f64 {
         let nearest = |bones: &[[DVec3; 2]]| {
             bones
@@ -185,41 +326,98 @@ mod tests {
         }
     }
 
+    /// A random tree of `n` joints (one or two roots); about a third of them children of
+    /// joint 0 on one line through it (siblings whose bones overlap, equally far from the
+    /// points around the line), a few at their parent's position (zero-length bones).
+    fn random_skeleton(rng: &mut SplitMix64, n: usize) -> Skeleton {
+        let mut parents = vec![NO_PARENT];
+        let mut positions = vec![Vec3::ZERO];
+        for k in 1..n {
+            let roll = rng.next_f64();
+            let (parent, position) = if roll < 0.35 {
+                (0, Vec3::Y * (rng.next_f64() as f32) * 2.0)
+            } else if k == n / 2 && roll < 0.5 {
+                (NO_PARENT, Vec3::X)
+            } else {
+                let parent = (rng.next_f64() * k as f64) as usize;
+                let offset = if roll > 0.95 {
+                    Vec3::ZERO
+                } else {
+                    Vec3::new(
+                        rng.next_f64() as f32 - 0.5,
+                        rng.next_f64() as f32 - 0.5,
+                        rng.next_f64() as f32 - 0.5,
+                    )
+                };
+                (parent as u32, positions[parent] + offset)
+            };
+            parents.push(parent);
+            positions.push(position);
+        }
+        Skeleton::from_positions(
+            (0..n).map(|k| format!("j{k}")).collect(),
+            parents,
+            &positions,
+        )
+        .unwrap()
+    }
+
     #[test]
-    fn pruned_nearest_bones_give_the_reference_kappa() {
+    fn indexed_bones_give_the_reference_kappa() {
         let mut rng = SplitMix64::new(7);
-        let mut point = || {
-            DVec3::new(
-                rng.next_f64() * 4.0 - 2.0,
-                rng.next_f64() * 4.0 - 2.0,
-                rng.next_f64() * 4.0 - 2.0,
-            )
-        };
-        for case in 0..20 {
-            let mut bones = |n: usize| -> Vec<[DVec3; 2]> {
-                (0..n)
-                    .map(|k| {
-                        let a = point();
-                        // Every fifth bone is a point.
-                        [a, if k % 5 == 0 { a } else { point() }]
-                    })
-                    .collect()
-            };
-            let own = bones(case % 4);
-            let other = bones(case % 7);
-            let ownership = Ownership {
-                own_bones: own.iter().map(|&[a, b]| Segment::new(a, b)).collect(),
-                other_bones: other.iter().map(|&[a, b]| Segment::new(a, b)).collect(),
-                half_width: 0.3,
-            };
-            for _ in 0..200 {
-                let p = point();
-                let expected = reference_kappa(&own, &other, 0.3, p);
-                let got = ownership.at(p);
-                assert!(
-                    (got - expected).abs() < 1e-12,
-                    "case {case} at {p}: {got} vs {expected}"
-                );
+        for case in 0..24 {
+            let n = [1, 2, 3, 8, 30, 90][case % 6];
+            let skeleton = random_skeleton(&mut rng, n);
+            let decisions: Vec<JointDecision> = (0..n)
+                .map(|k| JointDecision {
+                    name: format!("j{k}"),
+                    status: JointStatus::Skipped(String::new()),
+                    boundary: None,
+                    region: [None, Some(0), Some(1), Some(1)][(rng.next_f64() * 4.0) as usize],
+                    owns_skin: true,
+                })
+                .collect();
+            let handled: Vec<bool> = (0..n).map(|_| rng.next_f64() < 0.4).collect();
+            let segments = bone_segments(&skeleton);
+            let bones = OwnershipBones::new(&skeleton, &decisions, &segments);
+            let free = FreeBones::new(&skeleton, &segments, &handled);
+            let w = 0.3;
+            for joint in 0..n {
+                for region in 0..2 {
+                    let (own, other) =
+                        reference_bones(&skeleton, &decisions, &segments, joint, region);
+                    let owner = Ownership::new(&bones, joint, region, w);
+                    let beyond = handled[joint].then(|| {
+                        let reference =
+                            reference_beyond(&skeleton, &segments, joint, &handled, &other);
+                        (owner.beyond(&free, joint), reference)
+                    });
+                    for q in 0..40 {
+                        let (u, v, t) = (rng.next_f64(), rng.next_f64(), rng.next_f64());
+                        let p = if q % 2 == 0 {
+                            // Around the line of the root's collinear children.
+                            let angle = u * std::f64::consts::TAU;
+                            DVec3::new(0.2 * angle.cos(), 2.2 * v - 0.1, 0.2 * angle.sin())
+                        } else {
+                            DVec3::new(3.0 * u - 1.5, 3.0 * v - 1.0, 3.0 * t - 1.5)
+                        };
+                        let close = |got: f64, expected: f64| (got - expected).abs() < 1e-9;
+                        let expected = reference_kappa(&own, &other, w, p);
+                        let got = owner.at(p);
+                        assert!(
+                            close(got, expected),
+                            "case {case}, joint {joint}, region {region} at {p}: {got} vs {expected}"
+                        );
+                        if let Some((beyond, (own, other))) = &beyond {
+                            let expected = reference_kappa(own, other, w, p);
+                            let got = beyond.at(p);
+                            assert!(
+                                close(got, expected),
+                                "beyond: case {case}, joint {joint} at {p}: {got} vs {expected}"
+                            );
+                        }
+                    }
+                }
             }
         }
     }

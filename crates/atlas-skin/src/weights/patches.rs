@@ -26,7 +26,7 @@ use crate::decomposition::Decomposition;
 use crate::mesh::Topology;
 use crate::skeleton::bones::bone_segments;
 use crate::weights::blend::beta;
-use crate::weights::ownership::Ownership;
+use crate::weights::ownership::{Ownership, OwnershipBones};
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -81,19 +81,12 @@ pub fn leaf_patches(
         })
         .collect();
     let radii = region_radii(skeleton, &heads, &candidates);
-    let segments = bone_segments(skeleton);
+    let bones = OwnershipBones::new(skeleton, &decomposition.joints, &bone_segments(skeleton));
     candidates
         .par_iter()
         .filter_map(|&(j, region, tail)| {
             let radius = *radii.get(&region)?;
-            let owner = Ownership::new(
-                skeleton,
-                &decomposition.joints,
-                &segments,
-                j,
-                region,
-                0.5 * radius,
-            );
+            let owner = Ownership::new(&bones, j, region, 0.5 * radius);
             let share = |p: DVec3| {
                 let a = p.distance(tail);
                 if a >= radius {

@@ -3,15 +3,16 @@
 //! (module documentation of [`crate::weights`]).
 
 use super::blend::beta;
-use super::ownership::Ownership;
+use super::ownership::{FreeBones, Ownership, OwnershipBones};
 use crate::decomposition::{Boundary, BoundaryKind, Decomposition};
 use crate::overlap::Overlaps;
 use crate::rows::Rows;
+use crate::skeleton::bone_tree::BoneTree;
 use crate::skeleton::bones::bone_segments;
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
 use rayon::prelude::*;
-use std::collections::VecDeque;
+use std::collections::{HashSet, VecDeque};
 
 /// A soft boundary, ready for step 3.
 pub struct SoftSide {
@@ -20,22 +21,20 @@ pub struct SoftSide {
     point: DVec3,
     normal: DVec3,
     half_width: f64,
-    /// Bit v set when vertex v is on the child side reached along the surface.
-    reached: Vec<u64>,
-    /// (κ_c, π_c) of every reached vertex, by increasing vertex.
-    ownership: Vec<(u32, f64, f64)>,
+    /// (v, κ_c, π_c) of every vertex v on the child side reached along the surface, by
+    /// increasing vertex (s_c is 0 at the others).
+    reached: Vec<(u32, f64, f64)>,
 }
 
 impl SoftSide {
-    /// s_c(p) of the module documentation.
-    pub fn share(&self, v: usize, position: DVec3) -> f64 {
-        if self.reached[v / 64] & (1 << (v % 64)) == 0 {
-            return 0.0;
-        }
-        let (kappa, beyond) = self
-            .ownership
-            .binary_search_by_key(&(v as u32), |&(u, _, _)| u)
-            .map_or((0.0, 0.0), |i| (self.ownership[i].1, self.ownership[i].2));
+    /// The vertices reached along the surface with their (κ_c, π_c), by increasing vertex.
+    pub fn reached(&self) -> &[(u32, f64, f64)] {
+        &self.reached
+    }
+
+    /// s_c(p) of the module documentation at a reached vertex at `position`, with its
+    /// `kappa` κ_c and `beyond` π_c.
+    pub fn share(&self, position: DVec3, kappa: f64, beyond: f64) -> f64 {
         let signed = self.normal.dot(position - self.point);
         let w = self.half_width.max(f64::MIN_POSITIVE);
         beta(((w + signed) / (2.0 * w)).clamp(0.0, 1.0)).max(beyond) * kappa
@@ -54,7 +53,6 @@ pub fn soft_sides(
     skeleton: &Skeleton,
     overlaps: &Overlaps,
     related: &Rows<(u32, f64)>,
-    region_vertices: &[Vec<u32>],
 ) -> Vec<SoftSide> {
     let d = decomposition;
     let segments = bone_segments(skeleton);
@@ -66,39 +64,30 @@ pub fn soft_sides(
             handled[b.joint as usize] = true;
         }
     }
+    let bones = OwnershipBones::new(skeleton, &d.joints, &segments);
+    // The joints of the boundaries below are all handled, as `beyond` requires.
+    let free = FreeBones::new(skeleton, &segments, &handled);
+    // The surface's vertices as points, for the seeds near each joint.
+    let points: Vec<[DVec3; 2]> = d.surface.positions.iter().map(|&p| [p, p]).collect();
+    let vertices = BoneTree::of_segments(&points);
     d.boundaries
         .par_iter()
         .enumerate()
         .filter(|(_, b)| b.kind == BoundaryKind::Soft && b.diameter > 0.0)
         .filter_map(|(k, b)| {
             let half_width = overlaps.half_widths[k];
-            let owner = Ownership::new(
-                skeleton,
-                &d.joints,
-                &segments,
-                b.joint as usize,
-                b.parent_region,
-                half_width,
-            );
-            let beyond = owner.beyond(skeleton, &segments, b.joint as usize, &handled);
+            let owner = Ownership::new(&bones, b.joint as usize, b.parent_region, half_width);
+            let beyond = owner.beyond(&free, b.joint as usize);
             let in_region = |v: usize| related.row(v).iter().any(|&(r, _)| r == b.parent_region);
-            child_side(
-                d,
-                b,
-                half_width,
-                &owner,
-                &beyond,
-                in_region,
-                &region_vertices[b.parent_region as usize],
-            )
+            child_side(d, b, half_width, &owner, &beyond, in_region, &vertices)
         })
         .collect()
 }
 
 /// The child side of the soft boundary `b` (half-width `half_width`, κ from `owner`, π from
-/// `beyond`): the flood of [`soft_sides`] from the vertices of `region_seeds` (those its
-/// region reaches) near the joint, through vertices where `in_region` holds; `None` when no
-/// seed qualifies (an inactive boundary).
+/// `beyond`): the flood of [`soft_sides`] from the vertices near the joint (found in
+/// `vertices`, the surface's vertices as points), through vertices where `in_region` holds
+/// (those the region reaches); `None` when no seed qualifies (an inactive boundary).
 fn child_side(
     d: &Decomposition,
     b: &Boundary,
@@ -106,22 +95,19 @@ fn child_side(
     owner: &Ownership,
     beyond: &Ownership,
     in_region: impl Fn(usize) -> bool,
-    region_seeds: &[u32],
+    vertices: &BoneTree,
 ) -> Option<SoftSide> {
     let positions = &d.surface.positions;
-    let vertex_count = d.surface.vertex_count();
     let signed = |v: usize| b.normal.dot(positions[v] - b.point);
-    // Every vertex is examined once: κ depends on the vertex alone.
-    let words = vertex_count.div_ceil(64);
-    let (mut examined, mut reached) = (vec![0u64; words], vec![0u64; words]);
-    let mut ownership = Vec::new();
+    // Every vertex is examined once: κ depends on the vertex alone. (A set, not one bit
+    // per vertex of the surface: thousands of soft boundaries each reach a few vertices.)
+    let mut examined = HashSet::new();
+    let mut reached = Vec::new();
     let mut queue = VecDeque::new();
     let mut visit = |v: u32, queue: &mut VecDeque<u32>| {
-        let (word, bit) = (v as usize / 64, 1u64 << (v % 64));
-        if examined[word] & bit != 0 {
+        if !examined.insert(v) {
             return;
         }
-        examined[word] |= bit;
         if !in_region(v as usize) {
             return;
         }
@@ -134,15 +120,15 @@ fn child_side(
         }
         let kappa = owner.at(p);
         if kappa > 0.0 {
-            reached[word] |= bit;
-            ownership.push((v, kappa, past));
+            reached.push((v, kappa, past));
             queue.push_back(v);
         }
     };
+    // The seeds: the vertices near the joint (`visit` keeps those of the region; the
+    // flood's result does not depend on their order).
     let seed_radius = b.diameter.max(half_width);
-    for &v in region_seeds {
-        let p = positions[v as usize];
-        if p.distance(b.point) <= seed_radius && signed(v as usize) <= half_width {
+    for v in vertices.within(b.point, seed_radius) {
+        if signed(v as usize) <= half_width {
             visit(v, &mut queue);
         }
     }
@@ -154,7 +140,7 @@ fn child_side(
             visit(u, &mut queue);
         }
     }
-    ownership.sort_unstable_by_key(|&(v, _, _)| v);
+    reached.sort_unstable_by_key(|&(v, _, _)| v);
     Some(SoftSide {
         joint: b.joint,
         region: b.parent_region,
@@ -162,6 +148,5 @@ fn child_side(
         normal: b.normal,
         half_width,
         reached,
-        ownership,
     })
 }
