@@ -13,7 +13,7 @@ fn atlas_skin(args: &[&str]) -> String {
     String::from_utf8(atlas_skin_ok(args).stdout).expect("UTF-8 output")
 }
 
-fn bench_json(threads: &str, weight_format: &str) -> Value {
+fn bench_json(threads: &str, weight_format: &str, vertex_order: &str) -> Value {
     let text = atlas_skin(&[
         "bench",
         "--json",
@@ -25,19 +25,31 @@ fn bench_json(threads: &str, weight_format: &str) -> Value {
         "3",
         "--weight-format",
         weight_format,
+        "--vertex-order",
+        vertex_order,
     ]);
     serde_json::from_str(&text).expect("one JSON object")
 }
 
 /// The JSON report has every figure the issue names, for the requested size, threads and
-/// weight format (8-bit weights: 3 bytes fewer per explicit weight).
+/// weight format (8-bit weights: 3 bytes fewer per explicit weight) and vertex order
+/// (grouped by influence count: fewer influences blended per vertex).
 /// (That a frame allocates nothing is the runtime's `tests/no_allocation.rs`.)
 #[test]
 fn bench_runs_on_the_demo_character() {
-    let single = bench_json("1", "f32");
+    let single = bench_json("1", "f32", "mesh");
     assert_eq!(single["threads"], 1, "{single}");
     assert_eq!(single["weight_format"], "f32", "{single}");
-    let report = bench_json("2", "unorm8");
+    assert_eq!(single["vertex_order"], "mesh", "{single}");
+    let report = bench_json("2", "unorm8", "influences");
+    assert_eq!(report["vertex_order"], "influences", "{report}");
+    let blended = |r: &Value| {
+        r["blended_influences"]
+            .as_f64()
+            .expect("blended influences")
+    };
+    assert!(blended(&report) < blended(&single), "{single} {report}");
+    assert!(blended(&report) >= 1.0, "{report}");
     assert_eq!(report["vertices"], 20_000, "{report}");
     assert_eq!(report["threads"], 2, "{report}");
     assert_eq!(report["weight_format"], "unorm8", "{report}");
@@ -157,7 +169,11 @@ fn bench_writes_side_by_side_data() {
         message.contains(folder.to_str().expect("UTF-8 path")),
         "{message}"
     );
-    for (flag, value) in [("--instruction-set", "sse9"), ("--weight-format", "f16")] {
+    for (flag, value) in [
+        ("--instruction-set", "sse9"),
+        ("--weight-format", "f16"),
+        ("--vertex-order", "sorted"),
+    ] {
         let failed = support::atlas_skin(&["bench", "--frames", "1", flag, value]);
         assert!(!failed.status.success());
         let message = String::from_utf8_lossy(&failed.stderr);

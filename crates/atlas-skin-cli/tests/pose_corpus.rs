@@ -2,8 +2,9 @@
 //! 1e-5 of the bounding-box diagonal on every corpus model with weights, for linear blend
 //! and dual quaternion skinning of seeded random poses, sequential and parallel, with and
 //! without normals, with every instruction set this CPU runs (the portable loops always:
-//! what a CPU without AVX2 or AVX-512 runs), with float and quantised weights; and what
-//! quantising the weights costs in accuracy (`QUANTISED_ERROR`).
+//! what a CPU without AVX2 or AVX-512 runs), with float and quantised weights, in the
+//! mesh's vertex order and grouped by influence count (`VertexOrder`); and what quantising
+//! the weights costs in accuracy (`QUANTISED_ERROR`).
 
 use atlas_skin_io::LoadOptions;
 use atlas_skin_runtime::pose::palette_from_world;
@@ -14,7 +15,7 @@ use atlas_skin_runtime::reference::{
 };
 use atlas_skin_runtime::{
     CompactSkin, InstructionSet, Rig, SkinningJob, SkinningMethod, SkinningPalette, Threading,
-    WeightFormat,
+    VertexOrder, WeightFormat,
 };
 use glam::{Mat4, Vec3};
 use std::path::Path;
@@ -100,19 +101,33 @@ fn fast_paths_match_the_reference_on_the_corpus() {
             .rig
             .clone()
             .unwrap_or_else(|| Rig::from_skeleton(skeleton));
-        let rows = character.reference_weights.as_ref().expect("weights");
-        let rest = &character.mesh.positions;
-        let normals: Vec<Vec3> = rest
+        let mesh_rows = character.reference_weights.as_ref().expect("weights");
+        let mesh_rest = &character.mesh.positions;
+        let mesh_normals: Vec<Vec3> = mesh_rest
             .iter()
-            .map(|p| (*p - rest[0]).normalize_or(Vec3::Y))
+            .map(|p| (*p - mesh_rest[0]).normalize_or(Vec3::Y))
             .collect();
-        // Elephant rows have up to 23 influences: the N path with 8.
-        for (max_influences, format) in [
-            (4, WeightFormat::Float32),
-            (8, WeightFormat::Float32),
-            (4, WeightFormat::Unorm16),
-            (8, WeightFormat::Unorm8),
+        // Elephant rows have up to 23 influences: the N path with 8. `grouped`: the
+        // vertices reordered by influence count, as an engine would at load.
+        for (max_influences, format, grouped) in [
+            (4, WeightFormat::Float32, false),
+            (8, WeightFormat::Float32, false),
+            (4, WeightFormat::Unorm16, false),
+            (8, WeightFormat::Unorm8, false),
+            (4, WeightFormat::Float32, true),
         ] {
+            let order = grouped.then(|| VertexOrder::by_influence_count(mesh_rows, max_influences));
+            let reordered = order.as_ref().map(|order| {
+                (
+                    order.apply_weights(mesh_rows).expect("a row per vertex"),
+                    order.apply(mesh_rest).expect("a position per vertex"),
+                    order.apply(&mesh_normals).expect("a normal per vertex"),
+                )
+            });
+            let (rows, rest, normals) = match &reordered {
+                Some((rows, rest, normals)) => (rows, rest, normals),
+                None => (mesh_rows, mesh_rest, &mesh_normals),
+            };
             let skin = CompactSkin::with_format(rows, skeleton.len(), max_influences, format)
                 .expect("valid weights");
             let reference_weights = skin.to_vertex_weights();
@@ -154,11 +169,11 @@ fn fast_paths_match_the_reference_on_the_corpus() {
                         |weights, positions: &mut [Vec3], vectors: &mut [Vec3]| match method {
                             SkinningMethod::LinearBlend => {
                                 linear_blend_positions(rest, weights, &matrices, positions);
-                                linear_blend_vectors(&normals, weights, &matrices, vectors);
+                                linear_blend_vectors(normals, weights, &matrices, vectors);
                             }
                             SkinningMethod::DualQuaternion => {
                                 dual_quaternion_positions(rest, weights, &matrices, positions);
-                                dual_quaternion_vectors(&normals, weights, &matrices, vectors);
+                                dual_quaternion_vectors(normals, weights, &matrices, vectors);
                             }
                         };
                     reference(&reference_weights, &mut expected, &mut expected_normals);
@@ -191,7 +206,7 @@ fn fast_paths_match_the_reference_on_the_corpus() {
                         .run_with(set)
                         .expect("valid job");
                         let what = format!(
-                            "{folder}, K ≤ {max_influences} ({format:?}), seed {seed}, {method:?} (aligned {aligned}), {threading:?}, {}, normals {with_normals}",
+                            "{folder}, K ≤ {max_influences} ({format:?}, grouped {grouped}), seed {seed}, {method:?} (aligned {aligned}), {threading:?}, {}, normals {with_normals}",
                             set.name()
                         );
                         let error = max_distance(&positions, &expected);

@@ -24,6 +24,7 @@ mod skinning_avx2;
 mod skinning_avx512;
 pub mod skinning_job;
 pub mod skinning_palette;
+pub mod vertex_order;
 pub mod weights;
 
 pub use animation::{Clip, Interpolation, Property, Rig, Track, Trs};
@@ -34,4 +35,5 @@ pub use instruction_set::InstructionSet;
 pub use skeleton::{Skeleton, NO_PARENT};
 pub use skinning_job::{SkinningJob, Threading};
 pub use skinning_palette::{SkinningMethod, SkinningPalette};
+pub use vertex_order::VertexOrder;
 pub use weights::VertexWeights;

@@ -375,6 +375,60 @@ unsafe fn store_vec3_over_next(out: *mut Vec3, v: __m128) {
     _mm_storeu_ps(out.cast::<f32>(), v);
 }
 
+/// Vertices between the block being skinned and the block [`prefetch_block`] asks the
+/// caches for: 128 vertices ahead are 1.5 KB of each position or normal stream, a few
+/// hundred nanoseconds of the loop, about a memory access's latency. Measured at 1M
+/// vertices on 2 threads, as linear blending's copy-bandwidth fraction over that of dual
+/// quaternions (whose loop does not prefetch) in the same runs: 0.91–0.95 without
+/// prefetching, 1.02–1.04 at 32 and 64 vertices ahead, 1.04–1.09 at 128, 1.06 at 256.
+pub(crate) const PREFETCH_AHEAD: usize = 128;
+
+/// Asks the caches for the streams of the block of [`crate::compact_skin::INFLUENCE_BLOCK`]
+/// vertices from `v`, [`PREFETCH_AHEAD`] vertices before the loop reads them: the rest
+/// positions and normals, joints and weights to read, the posed positions and normals to
+/// write (a prefetch for writing, which owns the line before the stores arrive, so that
+/// they do not wait for it). The hardware prefetcher follows the streams too; these hints
+/// still gained (see [`PREFETCH_AHEAD`]). No prefetch goes past the span's end (it would
+/// fetch lines of another task's span).
+///
+/// # Safety
+/// SSE present (x86-64); `v + 8 ≤ span.len()`.
+#[inline(always)]
+pub(crate) unsafe fn prefetch_block(span: &Span, v: usize, k: usize) {
+    // The first and last float of the block's 24 of a Vec3 stream: both its lines.
+    let read = |p: *const f32| {
+        _mm_prefetch::<_MM_HINT_T0>(p.cast());
+        _mm_prefetch::<_MM_HINT_T0>(p.add(23).cast());
+    };
+    let write = |p: *const f32| {
+        _mm_prefetch::<_MM_HINT_ET0>(p.cast());
+        _mm_prefetch::<_MM_HINT_ET0>(p.add(23).cast());
+    };
+    read(span.rest_positions.as_ptr().cast::<f32>().add(3 * v));
+    write(span.out_positions.as_ptr().cast::<f32>().add(3 * v));
+    if !span.out_normals.is_empty() {
+        read(span.rest_normals.as_ptr().cast::<f32>().add(3 * v));
+        write(span.out_normals.as_ptr().cast::<f32>().add(3 * v));
+    }
+    _mm_prefetch::<_MM_HINT_T0>(span.joints.as_ptr().add(v * k).cast());
+    if k > 1 {
+        read(span.weights.as_ptr().add(v * (k - 1)));
+    }
+}
+
+/// [`prefetch_block`] for the block [`PREFETCH_AHEAD`] vertices after `v`, if the span has
+/// all of it.
+///
+/// # Safety
+/// SSE present (x86-64).
+#[inline(always)]
+pub(crate) unsafe fn prefetch_ahead(span: &Span, v: usize, k: usize) {
+    let ahead = v + PREFETCH_AHEAD;
+    if ahead + crate::compact_skin::INFLUENCE_BLOCK <= span.len() {
+        prefetch_block(span, ahead, k);
+    }
+}
+
 #[target_feature(enable = "avx2,fma")]
 #[inline]
 unsafe fn load_vec3(v: &Vec3, w: f32) -> __m128 {
@@ -433,6 +487,9 @@ unsafe fn linear_blend_span<const K: usize, const NORMALS: bool, const TANGENTS:
 ) {
     let k = if K == 0 { k } else { K };
     for (vertices, used) in span.blocks(k) {
+        if span.prefetch {
+            prefetch_ahead(&span, vertices.start, k);
+        }
         let block: BlockLoop = match used {
             1 => linear_blend_block::<1, NORMALS, TANGENTS>,
             2 => linear_blend_block::<2, NORMALS, TANGENTS>,

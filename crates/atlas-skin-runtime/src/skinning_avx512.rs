@@ -11,7 +11,7 @@
 //! per vertex.) The sums are the portable loop's (same blend order, implicit last weight).
 
 use crate::skinning_avx2::{
-    broadcast_load, half_products, load_index, sum_both_halves, sum_halves,
+    broadcast_load, half_products, load_index, prefetch_ahead, sum_both_halves, sum_halves,
 };
 use crate::skinning_job::{specialise, Kernel, Span};
 use glam::Mat4;
@@ -98,6 +98,9 @@ unsafe fn linear_blend_span<const K: usize, const NORMALS: bool>(
 ) {
     let k = if K == 0 { k } else { K };
     for (vertices, used) in span.blocks(k) {
+        if span.prefetch {
+            prefetch_ahead(&span, vertices.start, k);
+        }
         let block: InfluenceBlockLoop = match used {
             1 => linear_blend_block::<1, NORMALS>,
             2 => linear_blend_block::<2, NORMALS>,

@@ -18,6 +18,14 @@ const _: () = assert!(
     "spans split at block boundaries"
 );
 
+/// Vertices from which the vector loops of linear blending prefetch the streams ahead of
+/// the block they skin: 65,536 vertices of positions and normals in and out, joints and
+/// weights are 4.5 MB, beyond the second-level cache of one core, so the streams come
+/// from the last level or memory; in cache the prefetches would only cost instructions.
+/// (At 1M vertices on 2 threads they raised the copy-bandwidth fraction of linear blending
+/// from 0.78 to 0.98, medians of 6 interleaved runs.)
+pub const PREFETCH_FROM: usize = 1 << 16;
+
 /// The sign bit of an IEEE 754 single.
 const SIGN_BIT: u32 = 0x8000_0000;
 
@@ -54,7 +62,8 @@ pub enum Threading {
 /// lets the vector loops leave out the per-influence sign fix (checked per run, O(pairs)
 /// of [`CompactSkin::pairs`]; the result is the same). A skin with quantised weights
 /// ([`crate::WeightFormat`]) is run 64 vertices at a time, each piece's weights widened
-/// to floats on the stack first.
+/// to floats on the stack first. From [`PREFETCH_FROM`] vertices, the vector loops of
+/// linear blending prefetch the streams of the block 128 vertices ahead.
 ///
 /// The loop is specialised per influence count and stream set, and comes in the
 /// [`InstructionSet`] families: [`SkinningJob::run`] takes the widest this CPU runs
@@ -144,6 +153,7 @@ impl SkinningJob<'_> {
             hemispheres_agree: set != InstructionSet::Portable
                 && self.palette.method() == SkinningMethod::DualQuaternion
                 && self.palette.hemispheres_agree(self.skin),
+            prefetch: self.skin.vertex_count() >= PREFETCH_FROM,
             rest_positions: self.rest_positions,
             rest_normals: self.rest_normals.unwrap_or_default(),
             rest_tangents: self.rest_tangents.unwrap_or_default(),
@@ -311,6 +321,9 @@ pub(crate) struct Span<'a> {
     /// dot product ([`SkinningPalette::hemispheres_agree`]), so the sign fix may be left
     /// out.
     pub(crate) hemispheres_agree: bool,
+    /// The job's streams exceed the caches ([`PREFETCH_FROM`]): the vector loops prefetch
+    /// ahead of the block they skin.
+    pub(crate) prefetch: bool,
     pub(crate) rest_positions: &'a [Vec3],
     pub(crate) rest_normals: &'a [Vec3],
     pub(crate) rest_tangents: &'a [Vec4],
@@ -369,6 +382,7 @@ impl<'a> Span<'a> {
                 quantised: quantised_a,
                 block_influences: blocks_a,
                 hemispheres_agree: self.hemispheres_agree,
+                prefetch: self.prefetch,
                 rest_positions: rest_p_a,
                 rest_normals: rest_n_a,
                 rest_tangents: rest_t_a,
@@ -382,6 +396,7 @@ impl<'a> Span<'a> {
                 quantised: quantised_b,
                 block_influences: blocks_b,
                 hemispheres_agree: self.hemispheres_agree,
+                prefetch: self.prefetch,
                 rest_positions: rest_p_b,
                 rest_normals: rest_n_b,
                 rest_tangents: rest_t_b,
@@ -552,6 +567,7 @@ mod tests {
             quantised: Quantised::None,
             block_influences: skin.block_influences(),
             hemispheres_agree: false,
+            prefetch: false,
             rest_positions: rest,
             rest_normals: rest,
             rest_tangents: tangents,

@@ -1,4 +1,5 @@
-//! A frame allocates nothing: preparing the palette (with its hemispheres aligned) and skinning positions and normals, by
+//! A frame allocates nothing: preparing the palette (with its hemispheres aligned) and
+//! skinning positions and normals (of a small mesh and of one whose loops prefetch), by
 //! linear blend and by dual quaternions, with every instruction set this CPU runs, on one
 //! thread. This test binary alone replaces the global allocator by one that counts (the
 //! library and the `atlas-skin` binary use the system's unchanged).
@@ -42,14 +43,19 @@ unsafe impl GlobalAlloc for CountingAllocator {
 #[global_allocator]
 static GLOBAL: CountingAllocator = CountingAllocator;
 
+/// A small mesh, and one large enough for the loops that prefetch.
 #[test]
 fn a_frame_allocates_nothing() {
+    frames_allocate_nothing(5_000);
+    frames_allocate_nothing(atlas_skin_runtime::skinning_job::PREFETCH_FROM + 8);
+}
+
+fn frames_allocate_nothing(vertices: usize) {
     const JOINTS: usize = 16;
-    const VERTICES: usize = 5_000;
     let mut rng = SplitMix64::new(3);
-    let rest: Vec<Vec3> = (0..VERTICES).map(|_| rng.unit_vector()).collect();
-    let normals: Vec<Vec3> = (0..VERTICES).map(|_| rng.unit_vector()).collect();
-    let weights = VertexWeights::from_rows((0..VERTICES).map(|v| {
+    let rest: Vec<Vec3> = (0..vertices).map(|_| rng.unit_vector()).collect();
+    let normals: Vec<Vec3> = (0..vertices).map(|_| rng.unit_vector()).collect();
+    let weights = VertexWeights::from_rows((0..vertices).map(|v| {
         (0..1 + v % 4)
             .map(|k| (((v + 5 * k) % JOINTS) as u32, 0.1 + k as f32))
             .collect::<Vec<_>>()
@@ -63,8 +69,8 @@ fn a_frame_allocates_nothing() {
                 .collect()
         })
         .collect();
-    let mut out_positions = vec![Vec3::ZERO; VERTICES];
-    let mut out_normals = vec![Vec3::ZERO; VERTICES];
+    let mut out_positions = vec![Vec3::ZERO; vertices];
+    let mut out_normals = vec![Vec3::ZERO; vertices];
     for set in InstructionSet::ALL.into_iter().filter(|s| s.is_supported()) {
         for method in [SkinningMethod::LinearBlend, SkinningMethod::DualQuaternion] {
             let mut palette = SkinningPalette::new(JOINTS);
@@ -92,7 +98,7 @@ fn a_frame_allocates_nothing() {
                 frame(pose);
             }
             let allocations = ALLOCATIONS.load(Ordering::Relaxed) - before;
-            assert_eq!(allocations, 0, "{} {method:?}", set.name());
+            assert_eq!(allocations, 0, "{vertices}: {} {method:?}", set.name());
         }
     }
 }

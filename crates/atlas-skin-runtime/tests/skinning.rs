@@ -422,3 +422,79 @@ fn aligned_dual_quaternions_match_the_reference() {
         }
     }
 }
+
+/// A mesh of `PREFETCH_FROM` vertices and more, where the vector loops prefetch ahead of
+/// the block they skin (up to the span's last full block): with and without normals and
+/// tangents, sequential and parallel, every instruction set, still the scalar reference.
+#[test]
+fn large_meshes_prefetch_and_match_the_reference() {
+    use atlas_skin_runtime::random_pose::{random_rotations, SplitMix64};
+    use atlas_skin_runtime::skinning_job::PREFETCH_FROM;
+    const JOINTS: usize = 7;
+    let count = PREFETCH_FROM + 1003;
+    let mut rng = SplitMix64::new(17);
+    let rest: Vec<Vec3> = (0..count).map(|_| rng.unit_vector()).collect();
+    let normals: Vec<Vec3> = (0..count).map(|_| rng.unit_vector()).collect();
+    let weights = VertexWeights::from_rows((0..count).map(|v| {
+        (0..1 + (v / 5) % 4)
+            .map(|i| (((v + 3 * i) % JOINTS) as u32, 0.2 + (i as f32)))
+            .collect::<Vec<_>>()
+    }));
+    let skin = CompactSkin::new(&weights, JOINTS, 4).unwrap();
+    let reference_weights = skin.to_vertex_weights();
+    let matrices: Vec<Mat4> = random_rotations(JOINTS, 1.0, 3)
+        .into_iter()
+        .map(|q| Mat4::from_rotation_translation(q, rng.unit_vector()))
+        .collect();
+    let mut expected_p = vec![Vec3::ZERO; count];
+    let mut expected_n = vec![Vec3::ZERO; count];
+    linear_blend_positions(&rest, &reference_weights, &matrices, &mut expected_p);
+    linear_blend_vectors(&normals, &reference_weights, &matrices, &mut expected_n);
+    let tolerance = 1e-5 * diagonal(&rest);
+    for set in supported_sets() {
+        for threading in [Threading::Sequential, Threading::Parallel] {
+            for tangents in [false, true] {
+                let posed = run_job(
+                    set,
+                    &skin,
+                    &matrices,
+                    SkinningMethod::LinearBlend,
+                    threading,
+                    &rest,
+                    &normals,
+                    tangents,
+                )
+                .unwrap();
+                let what = format!("{set:?} {threading:?} tangents {tangents}");
+                assert!(
+                    max_distance(&posed.positions, &expected_p) <= tolerance,
+                    "{what}"
+                );
+                assert!(max_distance(&posed.normals, &expected_n) <= 1e-5, "{what}");
+            }
+            // Positions only: the loops without normal streams.
+            let mut palette = SkinningPalette::new(JOINTS);
+            palette
+                .update(&matrices, SkinningMethod::LinearBlend)
+                .unwrap();
+            let mut positions = vec![Vec3::ZERO; count];
+            SkinningJob {
+                skin: &skin,
+                palette: &palette,
+                threading,
+                rest_positions: &rest,
+                rest_normals: None,
+                rest_tangents: None,
+                out_positions: &mut positions,
+                out_normals: None,
+                out_tangents: None,
+            }
+            .run_with(set)
+            .unwrap();
+            assert!(
+                max_distance(&positions, &expected_p) <= tolerance,
+                "{set:?} {threading:?} positions only"
+            );
+        }
+    }
+}

@@ -24,11 +24,12 @@ use crate::input::InputArgs;
 use crate::skinning_data;
 use anyhow::{Context, Result};
 use atlas_skin_io::OutputPlan;
+use atlas_skin_runtime::compact_skin::INFLUENCE_BLOCK;
 use atlas_skin_runtime::random_pose::random_rotations;
 use atlas_skin_runtime::skinning_job::PARALLEL_CHUNK;
 use atlas_skin_runtime::{
     CompactSkin, InstructionSet, SkinningJob, SkinningMethod, SkinningPalette, Threading,
-    VertexWeights, WeightFormat,
+    VertexOrder, VertexWeights, WeightFormat,
 };
 use glam::{Mat4, Vec3};
 use rayon::prelude::*;
@@ -69,6 +70,12 @@ pub struct Args {
     #[arg(long, value_name = "FORMAT", default_value = "f32",
           value_parser = ["f32", "unorm16", "unorm8"])]
     pub weight_format: String,
+    /// The order of the vertices: as the mesh has them (mesh), or grouped by influence
+    /// count window by window (influences: `VertexOrder::by_influence_count`, the order an
+    /// engine applies once at load so that blocks of vertices blend alike).
+    #[arg(long, value_name = "ORDER", default_value = "mesh",
+          value_parser = ["mesh", "influences"])]
+    pub vertex_order: String,
     /// Print the figures as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -90,6 +97,11 @@ pub struct BenchReport {
     pub instruction_set: &'static str,
     /// How the skin stored its weights (`--weight-format`).
     pub weight_format: String,
+    /// The order of the vertices (`--vertex-order`).
+    pub vertex_order: String,
+    /// Influences the loops blend per vertex on average (per block of 8 vertices, its
+    /// longest row's; `CompactSkin::block_influences`).
+    pub blended_influences: f64,
     pub influences: usize,
     pub lbs_vertices_per_second: f64,
     pub dqs_vertices_per_second: f64,
@@ -118,7 +130,8 @@ pub fn run(args: Args) -> Result<()> {
     let count = args.vertices.unwrap_or(posable.rest_positions.len());
     let format = WeightFormat::from_name(&args.weight_format)
         .with_context(|| format!("unknown weight format {:?}", args.weight_format))?;
-    let mut streams = Streams::replicate(&posable, weights, count, format)?;
+    let grouped = args.vertex_order == "influences";
+    let mut streams = Streams::replicate(&posable, weights, count, (format, grouped))?;
     let palettes: Vec<Vec<Mat4>> = (0..POSES as u64)
         .map(|seed| {
             posable.palette(&posable.with_rotations(&random_rotations(
@@ -167,6 +180,8 @@ pub fn run(args: Args) -> Result<()> {
         batch: args.batch,
         instruction_set: set.name(),
         weight_format: args.weight_format.clone(),
+        vertex_order: args.vertex_order.clone(),
+        blended_influences: streams.blended_influences(),
         influences: streams.skin.influences(),
         lbs_vertices_per_second: lbs_rate,
         dqs_vertices_per_second: dqs_rate,
@@ -185,8 +200,16 @@ pub fn run(args: Args) -> Result<()> {
 
 fn print_report(r: &BenchReport) {
     println!(
-        "{} vertices, {} influences ({} weights), {} thread(s), {} loops, {} samples of {} frame(s) per method",
-        r.vertices, r.influences, r.weight_format, r.threads, r.instruction_set, r.frames, r.batch
+        "{} vertices, {} influences ({} weights, {:.2} blended per vertex in the {} order), {} thread(s), {} loops, {} samples of {} frame(s) per method",
+        r.vertices,
+        r.influences,
+        r.weight_format,
+        r.blended_influences,
+        r.vertex_order,
+        r.threads,
+        r.instruction_set,
+        r.frames,
+        r.batch
     );
     println!(
         "linear blend:    {:8.1} M vertices/s ({:.0}% of copy bandwidth)",
@@ -219,17 +242,27 @@ struct Streams {
 
 impl Streams {
     /// Vertex v is the character's vertex `v mod #V` (the mesh tiled in place: the same
-    /// work per vertex, a working set that grows with `count`).
+    /// work per vertex, a working set that grows with `count`); `grouped`: then reordered
+    /// by [`VertexOrder::by_influence_count`].
     fn replicate(
         posable: &Posable,
         weights: &VertexWeights,
         count: usize,
-        format: WeightFormat,
+        (format, grouped): (WeightFormat, bool),
     ) -> Result<Self> {
         let original = posable.rest_positions.len();
-        let tile = |v: usize| v % original;
-        let rows =
-            VertexWeights::from_rows((0..count).map(|v| weights.row(tile(v)).collect::<Vec<_>>()));
+        let rows = VertexWeights::from_rows(
+            (0..count).map(|v| weights.row(v % original).collect::<Vec<_>>()),
+        );
+        let sources: Vec<usize> = if grouped {
+            VertexOrder::by_influence_count(&rows, POSE_INFLUENCES)
+                .sources()
+                .to_vec()
+        } else {
+            (0..count).collect()
+        };
+        let rows = VertexWeights::from_rows(sources.iter().map(|&v| rows.row(v)));
+        let tile = |i: usize| sources[i] % original;
         let skin = CompactSkin::with_format(&rows, posable.skeleton.len(), POSE_INFLUENCES, format)
             .context("invalid skin weights")?;
         let copy_len = (bytes_per_vertex(&skin) * count / 2).div_ceil(8);
@@ -248,6 +281,16 @@ impl Streams {
 
     fn bytes_per_vertex(&self) -> usize {
         bytes_per_vertex(&self.skin)
+    }
+
+    /// Influences blended per vertex: each block's longest row, for each of its vertices.
+    fn blended_influences(&self) -> f64 {
+        let count = self.skin.vertex_count();
+        let blended: usize = (self.skin.block_influences().iter())
+            .enumerate()
+            .map(|(b, &k)| k as usize * (count - b * INFLUENCE_BLOCK).min(INFLUENCE_BLOCK))
+            .sum();
+        blended as f64 / count as f64
     }
 
     /// Bytes a copy pass reads plus writes: about those of a frame.
