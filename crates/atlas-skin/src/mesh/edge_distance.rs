@@ -1,15 +1,10 @@
 //! Shortest distances along the edges of a surface (Dijkstra 1959) from several sources,
-//! optionally within a radius, remembering which source is nearest. The weights stage
-//! gives a vertex no region reaches the weights of its nearest weighted vertex this way,
-//! and the evaluation measures bleeding with it.
+//! optionally within a radius. The evaluation measures bleeding with it.
 
 use super::surface::SurfaceMesh;
 use super::topology::Topology;
 use std::cmp::{Ordering, Reverse};
 use std::collections::BinaryHeap;
-
-/// Marks a vertex that no source reached.
-pub const NO_SOURCE: u32 = u32::MAX;
 
 /// A heap entry: a tentative distance and a tie-breaking key (a vertex index, or
 /// `Reverse` of one), ordered so that `BinaryHeap` (a max-heap) pops the smallest distance
@@ -44,8 +39,6 @@ impl<K: Ord> PartialOrd for Nearest<K> {
 pub struct EdgeDistances {
     /// #V distances, infinite where not reached.
     distance: Vec<f64>,
-    /// #V nearest sources, [`NO_SOURCE`] where not reached.
-    source: Vec<u32>,
     reached: Vec<u32>,
     /// Equal distances settle from the largest vertex index down.
     heap: BinaryHeap<Nearest<Reverse<u32>>>,
@@ -56,15 +49,13 @@ impl EdgeDistances {
     pub fn new(vertex_count: usize) -> Self {
         Self {
             distance: vec![f64::INFINITY; vertex_count],
-            source: vec![NO_SOURCE; vertex_count],
             reached: Vec::new(),
             heap: BinaryHeap::new(),
         }
     }
 
-    /// Distances from `sources` (each at distance 0, its own source) to every vertex whose
-    /// distance is at most `radius` (infinite for no bound). A vertex takes the source of
-    /// the neighbour through which it was first reached at its final distance.
+    /// Distances from `sources` (each at distance 0) to every vertex whose distance is at
+    /// most `radius` (infinite for no bound).
     pub fn search(
         &mut self,
         surface: &SurfaceMesh,
@@ -77,7 +68,6 @@ impl EdgeDistances {
                 self.reached.push(s);
             }
             self.distance[s as usize] = 0.0;
-            self.source[s as usize] = s;
             self.heap.push(Nearest {
                 distance: 0.0,
                 key: Reverse(s),
@@ -101,7 +91,6 @@ impl EdgeDistances {
                         self.reached.push(n);
                     }
                     self.distance[u] = d;
-                    self.source[u] = self.source[v];
                     self.heap.push(Nearest {
                         distance: d,
                         key: Reverse(n),
@@ -116,16 +105,10 @@ impl EdgeDistances {
         self.distance[vertex as usize].is_finite()
     }
 
-    /// The source nearest to `vertex` in the last search, if it was reached.
-    pub fn source(&self, vertex: u32) -> Option<u32> {
-        Some(self.source[vertex as usize]).filter(|&s| s != NO_SOURCE)
-    }
-
     /// Forgets the last search.
     pub fn clear(&mut self) {
         for &v in &self.reached {
             self.distance[v as usize] = f64::INFINITY;
-            self.source[v as usize] = NO_SOURCE;
         }
         self.reached.clear();
     }
