@@ -8,7 +8,7 @@
 //! no other bone: 1 wherever the own bones are the nearer, falling to 0 within one
 //! half-width w past the surface equidistant from both.
 //!
-//! The bones are indexed once for every joint ([`OwnershipBones`]): the joints numbered in
+//! The bones are indexed once for every joint (`OwnershipBones`): the joints numbered in
 //! depth-first order, so that the bones of a joint's subtree are one range of numbers, in
 //! hierarchies of bone boxes ([`crate::skeleton::bone_tree`]): one over every bone, one per
 //! region, one per group of the `beyond` factor. A distance costs a descent of a tree, not a
