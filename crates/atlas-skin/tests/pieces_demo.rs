@@ -4,7 +4,7 @@
 //! joint; the belt takes the weights of the body surface under it.
 
 use atlas_skin::fixtures::demo::demo_character;
-use atlas_skin::fixtures::shapes::{icosphere, ring, uv_sphere};
+use atlas_skin::fixtures::shapes::{capsule_chain, icosphere, ring, uv_sphere};
 use atlas_skin::geometry::point_triangle_distance;
 use atlas_skin::mesh::SurfaceMesh;
 use atlas_skin::pipeline::{skin, SkinInput, SkinParams, Skinned};
@@ -252,5 +252,40 @@ fn loose_pieces_do_not_change_the_weights_of_the_body() {
     for v in 0..alone.positions.len() {
         let (x, y): (Vec<_>, Vec<_>) = (a.weights.row(v).collect(), b.weights.row(v).collect());
         assert_eq!(x, y, "body vertex {v}");
+    }
+}
+
+#[test]
+fn a_braid_hanging_from_the_head_over_the_shoulder_moves_with_the_head() {
+    // A braid that starts inside the head and ends 6 cm above the left upper arm: its
+    // lower end is nearer the arm's skin and bone than the head's, but it hangs from the
+    // head, as an artist binds it.
+    let mut pieces = Pieces::with_head();
+    let (braid, _) = capsule_chain(
+        &[DVec3::new(0.10, 1.70, 0.0), DVec3::new(0.22, 1.52, 0.0)],
+        &[],
+        0.012,
+        8,
+        12,
+    );
+    pieces.add("braid", &braid, DVec3::ONE, DVec3::ZERO);
+    let skinned = pieces.skin();
+    let head = pieces.joint("head");
+    let d = &skinned.decomposition;
+    let lowest = pieces
+        .part("braid")
+        .min_by(|&u, &v| pieces.positions[u].y.total_cmp(&pieces.positions[v].y))
+        .expect("a braid vertex");
+    let arm_bone = [DVec3::new(0.22, 1.40, 0.0), DVec3::new(0.48, 1.40, 0.0)];
+    let p = d.surface.positions[skinned.welded_of_stored[lowest] as usize];
+    assert!(
+        atlas_skin::geometry::point_segment_distance(p, arm_bone[0], arm_bone[1])
+            < p.distance(DVec3::new(0.0, 1.60, 0.0)),
+        "the braid's end lies nearer the arm's bone than the head joint"
+    );
+    for v in pieces.part("braid") {
+        assert_eq!(treatment_of(&skinned, v), PieceTreatment::Rigid(head));
+        let row: Vec<(u32, f32)> = skinned.weights.row(v).collect();
+        assert_eq!(row, vec![(head, 1.0)], "braid vertex {v}");
     }
 }
