@@ -303,42 +303,87 @@ impl FaceSpheres {
     /// skipped once its box starts beyond the best hit, so a ray costs O(log F) boxes and a
     /// few triangles where it runs clear of the surface.
     pub fn first_hit(&self, mesh: &SurfaceMesh, origin: DVec3, direction: DVec3) -> Option<RayHit> {
+        self.ray_search(mesh, origin, direction, f64::INFINITY, false)
+    }
+
+    /// Whether the ray `origin + t · direction` hits a face at some 0 < t < `limit`: the
+    /// same as `first_hit(..).is_some_and(|h| h.distance < limit)`, but boxes entered at
+    /// `limit` or later are never opened and the search stops at the first hit found (a
+    /// segment seen clear of the surface costs only the boxes along it).
+    pub fn hit_before(
+        &self,
+        mesh: &SurfaceMesh,
+        origin: DVec3,
+        direction: DVec3,
+        limit: f64,
+    ) -> bool {
+        self.ray_search(mesh, origin, direction, limit, true)
+            .is_some()
+    }
+
+    /// The hit of [`Self::first_hit`] among those with t < `limit`; with `any`, the first
+    /// such hit found instead of the nearest.
+    fn ray_search(
+        &self,
+        mesh: &SurfaceMesh,
+        origin: DVec3,
+        direction: DVec3,
+        limit: f64,
+        any: bool,
+    ) -> Option<RayHit> {
         let nodes = &self.bvh.nodes;
         let mut best: Option<RayHit> = None;
         if nodes.is_empty() {
             return best;
         }
-        let beyond_best =
-            |entry: f64, best: &Option<RayHit>| best.is_some_and(|h| entry > h.distance);
-        let mut stack: Vec<u32> = Vec::with_capacity(64);
-        stack.push(0);
-        while let Some(k) = stack.pop() {
-            let node = &nodes[k as usize];
-            match node.ray_entry(origin, direction) {
-                Some(entry) if !beyond_best(entry, &best) => {}
-                _ => continue,
+        // A box entered beyond the best hit (or at the limit) holds no better hit.
+        let beyond = |entry: f64, best: &Option<RayHit>| match best {
+            Some(h) => entry > h.distance,
+            None => entry >= limit,
+        };
+        // (node, t at which the ray enters its box): each box is tested once, when its
+        // parent is opened.
+        let mut stack: Vec<(u32, f64)> = Vec::with_capacity(64);
+        if let Some(entry) = nodes[0].ray_entry(origin, direction) {
+            stack.push((0, entry));
+        }
+        while let Some((k, entry)) = stack.pop() {
+            if beyond(entry, &best) {
+                continue;
             }
+            let node = &nodes[k as usize];
             if node.count > 0 {
                 let (start, end) = (node.start as usize, (node.start + node.count) as usize);
                 for &f in &self.bvh.faces[start..end] {
-                    if let Some(t) = self.sphere_hit(mesh, f as usize, origin, direction) {
-                        if best.is_none_or(|h| t < h.distance || (t == h.distance && f < h.face)) {
-                            best = Some(RayHit {
-                                face: f,
-                                distance: t,
-                            });
+                    let Some(t) = self.sphere_hit(mesh, f as usize, origin, direction) else {
+                        continue;
+                    };
+                    let better = t < limit
+                        && best.is_none_or(|h| t < h.distance || (t == h.distance && f < h.face));
+                    if better {
+                        best = Some(RayHit {
+                            face: f,
+                            distance: t,
+                        });
+                        if any {
+                            return best;
                         }
                     }
                 }
                 continue;
             }
-            let (first, second) = (k + 1, k + node.start);
-            let entry = |n: u32| nodes[n as usize].ray_entry(origin, direction);
-            // Pushed last, popped first: the child the ray enters first.
-            if entry(first).unwrap_or(f64::INFINITY) <= entry(second).unwrap_or(f64::INFINITY) {
-                stack.extend([second, first]);
-            } else {
-                stack.extend([first, second]);
+            let entry = |n: u32| {
+                nodes[n as usize]
+                    .ray_entry(origin, direction)
+                    .map(|t| (n, t))
+            };
+            match (entry(k + 1), entry(k + node.start)) {
+                // Pushed last, popped first: the child the ray enters first.
+                (Some(first), Some(second)) if first.1 <= second.1 => {
+                    stack.extend([second, first]);
+                }
+                (Some(first), Some(second)) => stack.extend([first, second]),
+                (first, second) => stack.extend(first.or(second)),
             }
         }
         best
@@ -659,11 +704,17 @@ mod tests {
                         );
                     }
                     let fast = spheres.first_hit(&mesh, p, direction);
-                    assert_eq!(
-                        fast,
-                        first_hit_by_scan(&mesh, p, direction),
-                        "{file} joint {j}"
-                    );
+                    let scan = first_hit_by_scan(&mesh, p, direction);
+                    assert_eq!(fast, scan, "{file} joint {j}");
+                    // Bounded rays: short of the hit, at it and past it.
+                    let t = scan.map_or(1.0, |h| h.distance);
+                    for limit in [0.5 * t, t, t * (1.0 + 1e-9), 2.0 * t] {
+                        assert_eq!(
+                            spheres.hit_before(&mesh, p, direction, limit),
+                            scan.is_some_and(|h| h.distance < limit),
+                            "{file} joint {j} limit {limit}"
+                        );
+                    }
                     hits += usize::from(fast.is_some());
                 }
             }
