@@ -1,10 +1,10 @@
 //! Point and ray queries against a surface, pruned by per-face bounding spheres: nearest
 //! surface distance, faces near a point, first hit along a ray.
 //!
-//! Point queries visit a uniform grid of the sphere centres (about four faces per cell),
-//! ray queries descend a bounding volume hierarchy of the faces' boxes (the faces in
-//! Morton order of their centres, halved recursively: depth ⌈log₂ F⌉ at most); the exact
-//! test runs only on faces whose sphere passes.
+//! Faces near a point come from a uniform grid of the sphere centres (about four faces per
+//! cell); the nearest point and ray hits descend a bounding volume hierarchy of the faces'
+//! boxes (the faces in Morton order of their centres, halved recursively: depth ⌈log₂ F⌉
+//! at most); the exact test runs only on faces whose sphere passes.
 //! The decomposition asks them once per joint, never once per candidate plane.
 
 use super::surface::SurfaceMesh;
@@ -77,11 +77,6 @@ impl CentreGrid {
 
     fn index(&self, c: IVec3) -> usize {
         (c.x + self.dims.x * (c.y + self.dims.y * c.z)) as usize
-    }
-
-    fn contains(&self, p: DVec3) -> bool {
-        let q = (p - self.origin) / self.cell;
-        q.cmpge(DVec3::ZERO).all() && q.cmplt(self.dims.as_dvec3()).all()
     }
 
     /// Faces whose centre lies in a cell of the box `lo..=hi` of cell coordinates, except
@@ -218,55 +213,61 @@ impl FaceSpheres {
             .map_or(f64::INFINITY, |nearest| nearest.distance)
     }
 
-    /// Replaces `best` by the point of face `f` nearest to `p` when it is nearer (the
-    /// face's sphere tested first). Inlined into each of its loops: it runs for every face
-    /// a query visits.
-    #[inline(always)]
-    fn test_face(&self, mesh: &SurfaceMesh, p: DVec3, f: u32, best: &mut Option<NearestPoint>) {
-        let bound = best.map_or(f64::INFINITY, |b| b.distance);
-        if self.centres[f as usize].distance(p) - self.radii[f as usize] < bound {
-            let candidate = NearestPoint::on_face(mesh, f, p);
-            if candidate.distance < bound {
-                *best = Some(candidate);
-            }
-        }
-    }
-
     /// The nearest point of the surface to `p` ([`NearestPoint`]: its face, barycentric
-    /// coordinates and distance; of faces at the same distance, the first met), `None`
+    /// coordinates and distance; of faces at the same distance, the lowest index), `None`
     /// without faces.
     ///
-    /// Shells of cells around p's cell are visited outwards; |p − c_f| − r_f bounds the
-    /// distance to face f from below, so a face is tested exactly only when that bound is
-    /// below the best distance so far, and the search stops once every centre beyond the
-    /// shell (at least shell · cell away) is too far. A point outside the grid scans all.
+    /// Branch and bound on the hierarchy of face boxes: the distance from `p` to a node's
+    /// box bounds the distance to each of its faces from below, so a node is opened only
+    /// while that bound is at most the best distance so far, nearer child first, and a
+    /// face is tested exactly only when |p − c_f| − r_f (its sphere) is at most the best
+    /// too. A query costs O(log F) boxes and a few triangles however far `p` lies from
+    /// the surface (the grid's shells of cells grew with that distance). The result is
+    /// that of a scan of all faces in index order keeping strictly nearer ones
+    /// (`nearest_point_by_scan` in the tests): a face can be skipped only when its bound
+    /// exceeds a distance already found, so it can neither win nor tie.
     pub fn nearest_point(&self, mesh: &SurfaceMesh, p: DVec3) -> Option<NearestPoint> {
-        let mut best: Option<NearestPoint> = None;
-        let bound = |best: &Option<NearestPoint>| best.map_or(f64::INFINITY, |b| b.distance);
-        let test = |f: u32, best: &mut Option<NearestPoint>| self.test_face(mesh, p, f, best);
-        if self.centres.is_empty() {
+        let nodes = &self.bvh.nodes;
+        if nodes.is_empty() {
             return None;
         }
-        if !self.grid.contains(p) {
-            for f in 0..self.centres.len() as u32 {
-                test(f, &mut best);
+        let mut best: Option<NearestPoint> = None;
+        let bound = |best: &Option<NearestPoint>| best.map_or(f64::INFINITY, |b| b.distance);
+        // (node, squared distance from p to its box); the tree's depth is below 32.
+        let mut stack: Vec<(u32, f64)> = Vec::with_capacity(64);
+        stack.push((0, nodes[0].distance_squared(p)));
+        while let Some((k, gap)) = stack.pop() {
+            let limit = bound(&best);
+            if gap > limit * limit {
+                continue;
             }
-            return best;
-        }
-        let centre = self.grid.cell_of(p);
-        let rings = self.grid.dims.max_element();
-        for ring in 0..=rings {
-            let r = IVec3::splat(ring);
-            // Only the shell: the inner cells were visited by the earlier rings.
-            let inner = IVec3::splat(ring - 1);
-            for f in self
-                .grid
-                .faces_in(centre - r, centre + r, centre - inner, centre + inner)
-            {
-                test(f, &mut best);
+            let node = &nodes[k as usize];
+            if node.count > 0 {
+                let (start, end) = (node.start as usize, (node.start + node.count) as usize);
+                for &f in &self.bvh.faces[start..end] {
+                    let limit = bound(&best);
+                    if self.centres[f as usize].distance(p) - self.radii[f as usize] > limit {
+                        continue;
+                    }
+                    let candidate = NearestPoint::on_face(mesh, f, p);
+                    let nearer = candidate.distance < limit
+                        || best.is_some_and(|b| candidate.distance == b.distance && f < b.face);
+                    if nearer {
+                        best = Some(candidate);
+                    }
+                }
+                continue;
             }
-            if bound(&best) <= ring as f64 * self.grid.cell - self.max_radius {
-                break;
+            let (first, second) = (k + 1, k + node.start);
+            let (first_gap, second_gap) = (
+                nodes[first as usize].distance_squared(p),
+                nodes[second as usize].distance_squared(p),
+            );
+            // Pushed last, popped first: the nearer child.
+            if first_gap <= second_gap {
+                stack.extend([(second, second_gap), (first, first_gap)]);
+            } else {
+                stack.extend([(first, first_gap), (second, second_gap)]);
             }
         }
         best
@@ -302,42 +303,87 @@ impl FaceSpheres {
     /// skipped once its box starts beyond the best hit, so a ray costs O(log F) boxes and a
     /// few triangles where it runs clear of the surface.
     pub fn first_hit(&self, mesh: &SurfaceMesh, origin: DVec3, direction: DVec3) -> Option<RayHit> {
+        self.ray_search(mesh, origin, direction, f64::INFINITY, false)
+    }
+
+    /// Whether the ray `origin + t · direction` hits a face at some 0 < t < `limit`: the
+    /// same as `first_hit(..).is_some_and(|h| h.distance < limit)`, but boxes entered at
+    /// `limit` or later are never opened and the search stops at the first hit found (a
+    /// segment seen clear of the surface costs only the boxes along it).
+    pub fn hit_before(
+        &self,
+        mesh: &SurfaceMesh,
+        origin: DVec3,
+        direction: DVec3,
+        limit: f64,
+    ) -> bool {
+        self.ray_search(mesh, origin, direction, limit, true)
+            .is_some()
+    }
+
+    /// The hit of [`Self::first_hit`] among those with t < `limit`; with `any`, the first
+    /// such hit found instead of the nearest.
+    fn ray_search(
+        &self,
+        mesh: &SurfaceMesh,
+        origin: DVec3,
+        direction: DVec3,
+        limit: f64,
+        any: bool,
+    ) -> Option<RayHit> {
         let nodes = &self.bvh.nodes;
         let mut best: Option<RayHit> = None;
         if nodes.is_empty() {
             return best;
         }
-        let beyond_best =
-            |entry: f64, best: &Option<RayHit>| best.is_some_and(|h| entry > h.distance);
-        let mut stack: Vec<u32> = Vec::with_capacity(64);
-        stack.push(0);
-        while let Some(k) = stack.pop() {
-            let node = &nodes[k as usize];
-            match node.ray_entry(origin, direction) {
-                Some(entry) if !beyond_best(entry, &best) => {}
-                _ => continue,
+        // A box entered beyond the best hit (or at the limit) holds no better hit.
+        let beyond = |entry: f64, best: &Option<RayHit>| match best {
+            Some(h) => entry > h.distance,
+            None => entry >= limit,
+        };
+        // (node, t at which the ray enters its box): each box is tested once, when its
+        // parent is opened.
+        let mut stack: Vec<(u32, f64)> = Vec::with_capacity(64);
+        if let Some(entry) = nodes[0].ray_entry(origin, direction) {
+            stack.push((0, entry));
+        }
+        while let Some((k, entry)) = stack.pop() {
+            if beyond(entry, &best) {
+                continue;
             }
+            let node = &nodes[k as usize];
             if node.count > 0 {
                 let (start, end) = (node.start as usize, (node.start + node.count) as usize);
                 for &f in &self.bvh.faces[start..end] {
-                    if let Some(t) = self.sphere_hit(mesh, f as usize, origin, direction) {
-                        if best.is_none_or(|h| t < h.distance || (t == h.distance && f < h.face)) {
-                            best = Some(RayHit {
-                                face: f,
-                                distance: t,
-                            });
+                    let Some(t) = self.sphere_hit(mesh, f as usize, origin, direction) else {
+                        continue;
+                    };
+                    let better = t < limit
+                        && best.is_none_or(|h| t < h.distance || (t == h.distance && f < h.face));
+                    if better {
+                        best = Some(RayHit {
+                            face: f,
+                            distance: t,
+                        });
+                        if any {
+                            return best;
                         }
                     }
                 }
                 continue;
             }
-            let (first, second) = (k + 1, k + node.start);
-            let entry = |n: u32| nodes[n as usize].ray_entry(origin, direction);
-            // Pushed last, popped first: the child the ray enters first.
-            if entry(first).unwrap_or(f64::INFINITY) <= entry(second).unwrap_or(f64::INFINITY) {
-                stack.extend([second, first]);
-            } else {
-                stack.extend([first, second]);
+            let entry = |n: u32| {
+                nodes[n as usize]
+                    .ray_entry(origin, direction)
+                    .map(|t| (n, t))
+            };
+            match (entry(k + 1), entry(k + node.start)) {
+                // Pushed last, popped first: the child the ray enters first.
+                (Some(first), Some(second)) if first.1 <= second.1 => {
+                    stack.extend([second, first]);
+                }
+                (Some(first), Some(second)) => stack.extend([first, second]),
+                (first, second) => stack.extend(first.or(second)),
             }
         }
         best
@@ -462,6 +508,14 @@ fn morton_code(cell: glam::UVec3) -> u64 {
 }
 
 impl BvhNode {
+    /// Squared distance from `p` to the box, 0 inside it.
+    fn distance_squared(&self, p: DVec3) -> f64 {
+        (self.lo - p)
+            .max(p - self.hi)
+            .max(DVec3::ZERO)
+            .length_squared()
+    }
+
     /// Smallest t ≥ 0 at which the ray is in the box (slab test), `None` when it misses.
     fn ray_entry(&self, origin: DVec3, direction: DVec3) -> Option<f64> {
         let (mut near, mut far) = (0.0f64, f64::INFINITY);
@@ -594,7 +648,7 @@ mod tests {
     /// Rays from every joint of makehuman's body and cesiumman along its bones and six
     /// turned axes (the rays the decomposition casts), by the hierarchy and by a full scan.
     #[test]
-    fn hierarchy_ray_hits_match_a_full_scan_on_the_corpus() {
+    fn hierarchy_queries_match_a_full_scan_on_the_corpus() {
         use atlas_skin_io::{load_character, LoadOptions};
         let models = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/models");
         let cases = [
@@ -641,12 +695,26 @@ mod tests {
                     DVec3::NEG_Z,
                 ];
                 for direction in axes.into_iter().map(|a| turn * a).chain(bone) {
+                    // The nearest surface point of points inside and around the body.
+                    for q in [p, p + direction * 0.1, p + direction] {
+                        assert_eq!(
+                            spheres.nearest_point(&mesh, q),
+                            nearest_point_by_scan(&mesh, q),
+                            "{file} joint {j}"
+                        );
+                    }
                     let fast = spheres.first_hit(&mesh, p, direction);
-                    assert_eq!(
-                        fast,
-                        first_hit_by_scan(&mesh, p, direction),
-                        "{file} joint {j}"
-                    );
+                    let scan = first_hit_by_scan(&mesh, p, direction);
+                    assert_eq!(fast, scan, "{file} joint {j}");
+                    // Bounded rays: short of the hit, at it and past it.
+                    let t = scan.map_or(1.0, |h| h.distance);
+                    for limit in [0.5 * t, t, t * (1.0 + 1e-9), 2.0 * t] {
+                        assert_eq!(
+                            spheres.hit_before(&mesh, p, direction, limit),
+                            scan.is_some_and(|h| h.distance < limit),
+                            "{file} joint {j} limit {limit}"
+                        );
+                    }
                     hits += usize::from(fast.is_some());
                 }
             }
@@ -678,38 +746,44 @@ mod tests {
         }
     }
 
+    /// The reference of [`FaceSpheres::nearest_point`]: every face in index order, a face
+    /// kept only when strictly nearer.
+    fn nearest_point_by_scan(mesh: &SurfaceMesh, p: DVec3) -> Option<NearestPoint> {
+        (0..mesh.triangle_count() as u32)
+            .map(|f| NearestPoint::on_face(mesh, f, p))
+            .fold(None, |best: Option<NearestPoint>, candidate| match best {
+                Some(b) if b.distance <= candidate.distance => Some(b),
+                _ => Some(candidate),
+            })
+    }
+
     #[test]
-    fn grid_nearest_distance_matches_a_full_scan() {
+    fn nearest_point_and_faces_near_match_a_full_scan() {
         let (mesh, _) = crate::fixtures::shapes::bent_cylinder(0.5, 3.0, 70.0, 24, 12);
         let spheres = FaceSpheres::new(&mesh);
-        let full = |p: DVec3| {
-            (0..mesh.triangle_count())
-                .map(|f| {
-                    let [a, b, c] = mesh.corners(f);
-                    point_triangle_distance(p, a, b, c)
-                })
-                .fold(f64::INFINITY, f64::min)
-        };
         let mut state = 0x2545_f491_4f6c_dd1du64;
-        for _ in 0..200 {
+        for query in 0..400 {
             let mut next = || {
                 state ^= state << 13;
                 state ^= state >> 7;
                 state ^= state << 17;
                 (state >> 11) as f64 / (1u64 << 53) as f64
             };
-            let p = DVec3::new(next() * 5.0 - 1.5, next() * 7.0 - 1.0, next() * 3.0 - 1.5);
-            let (grid, scan) = (spheres.nearest_distance(&mesh, p), full(p));
-            assert!((grid - scan).abs() < 1e-12, "{p}: {grid} vs {scan}");
-            let nearest = spheres.nearest_point(&mesh, p).expect("faces");
-            let [a, b, c] = mesh.corners(nearest.face as usize);
-            let [u, v, w] = nearest.barycentric;
+            // Every fourth point far outside the surface's box.
+            let spread = if query % 4 == 3 { 40.0 } else { 1.0 };
+            let p = DVec3::new(next() * 5.0 - 1.5, next() * 7.0 - 1.0, next() * 3.0 - 1.5) * spread;
+            let scan = nearest_point_by_scan(&mesh, p).expect("faces");
+            assert_eq!(spheres.nearest_point(&mesh, p), Some(scan), "{p}");
+            assert_eq!(spheres.nearest_distance(&mesh, p), scan.distance);
+            let scan_distance = (0..mesh.triangle_count())
+                .map(|f| {
+                    let [a, b, c] = mesh.corners(f);
+                    point_triangle_distance(p, a, b, c)
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert!((scan.distance - scan_distance).abs() < 1e-12, "{p}");
+            let [u, v, w] = scan.barycentric;
             assert!(u.min(v).min(w) >= 0.0 && (u + v + w - 1.0).abs() < 1e-12);
-            let q = a * u + b * v + c * w;
-            assert!(
-                (q.distance(p) - scan).abs() < 1e-12,
-                "{p}: {q} is not the nearest point"
-            );
             let radius = next();
             let near: Vec<u32> = (0..mesh.triangle_count() as u32)
                 .filter(|&f| {

@@ -151,9 +151,7 @@ fn nearest_seen_bone(
             return Some((j, d));
         }
         let direction = (q - p) / d;
-        let blocked = spheres
-            .first_hit(surface, p + direction * step, direction)
-            .is_some_and(|hit| hit.distance < d - 2.0 * step);
+        let blocked = spheres.hit_before(surface, p + direction * step, direction, d - 2.0 * step);
         if !blocked {
             return Some((j, d));
         }
