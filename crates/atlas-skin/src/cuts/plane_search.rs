@@ -25,7 +25,7 @@ use crate::cuts::plane_section::{
 };
 use crate::mesh::spatial_index::FaceSpheres;
 use crate::mesh::{SurfaceMesh, Topology};
-use crate::skeleton::bone_tree::BoneTree;
+use crate::skeleton::bones::BoneIndex;
 use glam::DVec3;
 
 /// How many times the neighbourhood doubles when it holds no closed section around the
@@ -66,44 +66,6 @@ pub struct CutSearch {
     /// Closed sections around the joint turned down because another bone passes through
     /// them (in the last neighbourhood tried).
     pub enclosing_other_bones: usize,
-}
-
-/// The bones of the skeleton as segments, with a tree for the bones near a point.
-#[derive(Debug, Clone)]
-pub struct BoneIndex {
-    /// (parent, child) joints of every bone ([`crate::skeleton::bones::joint_pairs`]).
-    pairs: Vec<(usize, usize)>,
-    segments: Vec<[DVec3; 2]>,
-    tree: BoneTree,
-}
-
-impl BoneIndex {
-    /// - `positions`: #J bind positions of the joints of `pairs`.
-    pub fn new(pairs: Vec<(usize, usize)>, positions: &[DVec3]) -> Self {
-        let segments: Vec<[DVec3; 2]> = pairs
-            .iter()
-            .map(|&(p, c)| [positions[p], positions[c]])
-            .collect();
-        let tree = BoneTree::of_segments(&segments);
-        Self {
-            pairs,
-            segments,
-            tree,
-        }
-    }
-
-    /// The bones with neither end at `joint` within `radius` of `point`, in bone order.
-    fn near(&self, joint: usize, point: DVec3, radius: f64) -> Vec<[DVec3; 2]> {
-        self.tree
-            .within(point, radius)
-            .into_iter()
-            .filter(|&k| {
-                let (p, c) = self.pairs[k as usize];
-                p != joint && c != joint
-            })
-            .map(|k| self.segments[k as usize])
-            .collect()
-    }
 }
 
 /// Every closed section around joint `joint` (its `frame`) that no other bone of `bones`

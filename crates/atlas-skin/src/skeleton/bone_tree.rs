@@ -16,6 +16,7 @@
 
 use crate::geometry::point_segment_distance;
 use glam::DVec3;
+use std::ops::ControlFlow;
 
 /// Segments per leaf.
 const LEAF: usize = 4;
@@ -188,8 +189,40 @@ impl BoneTree {
     /// ([`point_segment_distance`] ≤ `radius`): the same as a scan of every segment.
     pub fn within(&self, p: DVec3, radius: f64) -> Vec<u32> {
         let mut found = Vec::new();
+        let _: ControlFlow<()> = self.visit_within(p, radius, |key| {
+            found.push(key);
+            ControlFlow::Continue(())
+        });
+        found.sort_unstable();
+        found
+    }
+
+    /// A key of a segment within `radius` of `p` for which `admit(key)` holds, `None` when
+    /// there is none (the same answer as a scan; which key, when several qualify, is the
+    /// first met in the tree's order). Stops at the first: the thousands of sibling bones
+    /// through one point cost one descent.
+    pub fn find_within(&self, p: DVec3, radius: f64, admit: impl Fn(u32) -> bool) -> Option<u32> {
+        match self.visit_within(p, radius, |key| {
+            if admit(key) {
+                ControlFlow::Break(key)
+            } else {
+                ControlFlow::Continue(())
+            }
+        }) {
+            ControlFlow::Break(key) => Some(key),
+            ControlFlow::Continue(()) => None,
+        }
+    }
+
+    /// Calls `visit` with the key of every segment within `radius` of `p` until it breaks.
+    fn visit_within<B>(
+        &self,
+        p: DVec3,
+        radius: f64,
+        mut visit: impl FnMut(u32) -> ControlFlow<B>,
+    ) -> ControlFlow<B> {
         if self.nodes.is_empty() {
-            return found;
+            return ControlFlow::Continue(());
         }
         // Boxes are skipped only when clearly farther: the exact test is the segment's.
         let reach = radius * (1.0 + 1e-9);
@@ -201,17 +234,14 @@ impl BoneTree {
             }
             if node.count > 0 {
                 let leaf = &self.items[node.first as usize..(node.first + node.count) as usize];
-                found.extend(
-                    leaf.iter()
-                        .filter(|item| item.distance(p) <= radius)
-                        .map(|item| item.key),
-                );
+                for item in leaf.iter().filter(|item| item.distance(p) <= radius) {
+                    visit(item.key)?;
+                }
             } else {
                 stack.extend([index + 1, node.right]);
             }
         }
-        found.sort_unstable();
-        found
+        ControlFlow::Continue(())
     }
 }
 
@@ -362,6 +392,11 @@ mod tests {
                     })
                     .collect();
                 assert_eq!(tree.within(p, radius), near);
+                // A filter that admits only odd keys: found when a scan finds one.
+                let odd = |k: u32| k % 2 == 1;
+                let found = tree.find_within(p, radius, odd);
+                assert_eq!(found.is_some(), near.iter().any(|&k| odd(k)));
+                assert!(found.is_none_or(|k| odd(k) && near.contains(&k)));
             }
         }
     }

@@ -3,6 +3,7 @@
 //! simplest automatic weights: the fallback of the weights stage and a baseline).
 
 use crate::geometry::point_segment_distance;
+use crate::skeleton::bone_tree::BoneTree;
 use atlas_skin_runtime::{Skeleton, VertexWeights};
 use glam::DVec3;
 
@@ -46,14 +47,61 @@ pub fn joint_pairs(skeleton: &Skeleton, positions: &[DVec3]) -> Vec<(usize, usiz
         .collect()
 }
 
-/// The bones of `pairs` ([`joint_pairs`]) with neither end at joint `j`, as segments:
-/// what a cut or a leaf's reach at `j` must keep clear of.
-pub fn bones_not_at(pairs: &[(usize, usize)], positions: &[DVec3], j: usize) -> Vec<[DVec3; 2]> {
-    pairs
-        .iter()
-        .filter(|&&(p, c)| p != j && c != j)
-        .map(|&(p, c)| [positions[p], positions[c]])
-        .collect()
+/// The bones of a skeleton ([`joint_pairs`]) as segments, with a tree for the bones near a
+/// point: what a cut or a leaf's reach at a joint must keep clear of.
+#[derive(Debug, Clone)]
+pub struct BoneIndex {
+    /// (parent, child) joints of every bone.
+    pairs: Vec<(usize, usize)>,
+    segments: Vec<[DVec3; 2]>,
+    tree: BoneTree,
+}
+
+impl BoneIndex {
+    /// - `positions`: #J bind positions of the joints of `pairs`.
+    pub fn new(pairs: Vec<(usize, usize)>, positions: &[DVec3]) -> Self {
+        let segments: Vec<[DVec3; 2]> = pairs
+            .iter()
+            .map(|&(p, c)| [positions[p], positions[c]])
+            .collect();
+        let tree = BoneTree::of_segments(&segments);
+        Self {
+            pairs,
+            segments,
+            tree,
+        }
+    }
+
+    /// The bones with neither end at `joint` within `radius` of `point`, in bone order.
+    pub fn near(&self, joint: usize, point: DVec3, radius: f64) -> Vec<[DVec3; 2]> {
+        self.tree
+            .within(point, radius)
+            .into_iter()
+            .filter(|&k| self.not_at(k, joint))
+            .map(|k| self.segments[k as usize])
+            .collect()
+    }
+
+    /// A bone, as its (parent, child) joints, with neither end at `joint` within `radius`
+    /// of `point` for whose segment `admit` holds; `None` when there is none.
+    pub fn find_near(
+        &self,
+        joint: usize,
+        point: DVec3,
+        radius: f64,
+        admit: impl Fn([DVec3; 2]) -> bool,
+    ) -> Option<(usize, usize)> {
+        self.tree
+            .find_within(point, radius, |k| {
+                self.not_at(k, joint) && admit(self.segments[k as usize])
+            })
+            .map(|k| self.pairs[k as usize])
+    }
+
+    fn not_at(&self, bone: u32, joint: usize) -> bool {
+        let (p, c) = self.pairs[bone as usize];
+        p != joint && c != joint
+    }
 }
 
 /// Weight 1 on the joint owning the bone segment nearest to each position (Euclidean, not
@@ -100,8 +148,69 @@ pub fn nearest_bone_with_distance(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use atlas_skin_runtime::random_pose::SplitMix64;
     use atlas_skin_runtime::NO_PARENT;
     use glam::Vec3;
+
+    /// The reference of [`BoneIndex::near`]: every bone of `pairs` with neither end at `j`
+    /// within `radius` of `point`, by a scan.
+    fn bones_near_by_scan(
+        pairs: &[(usize, usize)],
+        positions: &[DVec3],
+        j: usize,
+        point: DVec3,
+        radius: f64,
+    ) -> Vec<[DVec3; 2]> {
+        pairs
+            .iter()
+            .filter(|&&(p, c)| p != j && c != j)
+            .map(|&(p, c)| [positions[p], positions[c]])
+            .filter(|&[a, b]| point_segment_distance(point, a, b) <= radius)
+            .collect()
+    }
+
+    /// Random trees with sibling bones on one line (a root with many children), queried
+    /// at joints: the index finds what a scan finds.
+    #[test]
+    fn the_bone_index_finds_what_a_scan_finds() {
+        let mut rng = SplitMix64::new(18);
+        for case in 0..20 {
+            let count = 2 + case * 7;
+            let mut positions = vec![DVec3::ZERO];
+            let mut pairs = Vec::new();
+            for j in 1..count {
+                let sibling = j % 3 == 0;
+                let parent = if sibling {
+                    0
+                } else {
+                    (rng.next_f64() * j as f64) as usize
+                };
+                let p = if sibling {
+                    DVec3::Y * rng.next_f64()
+                } else {
+                    DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64())
+                };
+                positions.push(p);
+                if positions[parent] != p {
+                    pairs.push((parent, j));
+                }
+            }
+            let index = BoneIndex::new(pairs.clone(), &positions);
+            for j in 0..count {
+                for radius in [0.0, 1e-9, 0.1, 0.5] {
+                    let point = positions[j];
+                    let expected = bones_near_by_scan(&pairs, &positions, j, point, radius);
+                    assert_eq!(index.near(j, point, radius), expected);
+                    let long = |[a, b]: [DVec3; 2]| a.distance(b) > 0.5;
+                    let found = index.find_near(j, point, radius, long);
+                    assert_eq!(found.is_some(), expected.iter().any(|&s| long(s)));
+                    if let Some((p, c)) = found {
+                        assert!(p != j && c != j && long([positions[p], positions[c]]));
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn vertices_bind_to_the_bone_they_lie_along() {
