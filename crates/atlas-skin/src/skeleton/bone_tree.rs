@@ -16,6 +16,8 @@
 
 use crate::geometry::point_segment_distance;
 use glam::DVec3;
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
 use std::ops::ControlFlow;
 
 /// Segments per leaf.
@@ -214,6 +216,50 @@ impl BoneTree {
         }
     }
 
+    /// Calls `visit` with the key and the distance of every segment within `radius` of
+    /// `p`, nearest first (equal distances in any order), until it breaks: the k nearest
+    /// cost about k descents, not a scan.
+    pub fn visit_nearest_first<B>(
+        &self,
+        p: DVec3,
+        radius: f64,
+        mut visit: impl FnMut(u32, f64) -> ControlFlow<B>,
+    ) -> ControlFlow<B> {
+        // (distance, 0 for a node or 1 for a segment, index); distances are non-negative,
+        // so their bits order them.
+        let mut heap: BinaryHeap<Reverse<(u64, u8, u32)>> = BinaryHeap::new();
+        if let Some(root) = self.nodes.first() {
+            heap.push(Reverse((root.distance(p).to_bits(), 0, 0)));
+        }
+        // Boxes are passed over only when clearly farther, as in `visit_within`.
+        let reach = radius * (1.0 + 1e-9);
+        while let Some(Reverse((bits, kind, index))) = heap.pop() {
+            let distance = f64::from_bits(bits);
+            if distance > reach {
+                break;
+            }
+            if kind == 1 {
+                if distance <= radius {
+                    visit(self.items[index as usize].key, distance)?;
+                }
+                continue;
+            }
+            let node = &self.nodes[index as usize];
+            if node.count > 0 {
+                for i in node.first..node.first + node.count {
+                    let d = self.items[i as usize].distance(p);
+                    heap.push(Reverse((d.to_bits(), 1, i)));
+                }
+            } else {
+                for child in [index + 1, node.right] {
+                    let d = self.nodes[child as usize].distance(p);
+                    heap.push(Reverse((d.to_bits(), 0, child)));
+                }
+            }
+        }
+        ControlFlow::Continue(())
+    }
+
     /// Calls `visit` with the key of every segment within `radius` of `p` until it breaks.
     fn visit_within<B>(
         &self,
@@ -397,6 +443,16 @@ mod tests {
                 let found = tree.find_within(p, radius, odd);
                 assert_eq!(found.is_some(), near.iter().any(|&k| odd(k)));
                 assert!(found.is_none_or(|k| odd(k) && near.contains(&k)));
+                // Nearest first: the distances of a scan, sorted.
+                let mut visited = Vec::new();
+                let _: ControlFlow<()> = tree.visit_nearest_first(p, radius, |k, d| {
+                    visited.push((k, d));
+                    ControlFlow::Continue(())
+                });
+                assert!(visited.windows(2).all(|w| w[0].1 <= w[1].1));
+                let mut keys: Vec<u32> = visited.iter().map(|&(k, _)| k).collect();
+                keys.sort_unstable();
+                assert_eq!(keys, near);
             }
         }
     }
