@@ -54,6 +54,7 @@ use crate::tolerance::NEGLIGIBLE;
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
 use rayon::prelude::*;
+use std::collections::HashSet;
 
 /// The skeleton's mirror plane: points x with n · x = `offset`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -455,6 +456,10 @@ pub fn infer_symmetry_plane(
             break;
         }
     }
+    // Equal normals give equal planes: each is tried once (the first kept, so that the
+    // first of equal minima still wins). 100 siblings on one line give one normal.
+    let mut tried = HashSet::new();
+    normals.retain(|n| tried.insert(n.to_array().map(f64::to_bits)));
     let joints = PointGrid::new(positions);
     normals
         .into_iter()
