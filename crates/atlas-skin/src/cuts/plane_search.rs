@@ -104,7 +104,7 @@ pub fn find_cut_candidates(
 }
 
 /// A bone not at `joint` that crosses every coarse sample plane of the search within
-/// [`AT_JOINT`] × r of the joint (r its surface distance; exactly at the joint when r is
+/// `AT_JOINT` × r of the joint (r its surface distance; exactly at the joint when r is
 /// 0). Every closed section around the joint encloses such a crossing, so every sample
 /// plane is turned down, no refinement follows, and the search finds nothing, in every
 /// neighbourhood. The sections are not computed: on 10,000 siblings of one root, each

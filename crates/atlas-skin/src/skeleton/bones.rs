@@ -285,10 +285,9 @@ mod tests {
                 });
             }
             let joints = JointsOnSegments::new(&positions);
-            for j in 1..count {
-                let end = positions[j] * 1.5;
+            for (j, &start) in positions.iter().enumerate().skip(1) {
+                let end = start * 1.5;
                 for wanted in [1, 3, EXTENSION_JOINTS] {
-                    let start = positions[j];
                     let got = joints.kth_on(j, end, wanted).map(|p| p.distance(start));
                     let expected = kth_on_by_scan(&joints, j, end, wanted);
                     assert_eq!(got.is_some(), expected.is_some(), "case {case}, joint {j}");
