@@ -13,15 +13,13 @@
 
 use crate::cuts::conflicts::{place_cuts, Placement};
 use crate::cuts::joint_roles::{plan_joints, JointFrame, JointPlan};
-use crate::cuts::plane_search::{
-    find_cut_candidates, BoneIndex, CutCandidate, CutSearch, CutSurface,
-};
+use crate::cuts::plane_search::{find_cut_candidates, CutCandidate, CutSearch, CutSurface};
 use crate::cuts::plane_section::{diameter, vertex_snap_distances, DomainScratch};
 use crate::cuts::split::split_along_curves;
 use crate::decomposition::{Boundary, BoundaryKind, Decomposition, JointDecision, JointStatus};
 use crate::mesh::{FaceSpheres, SurfaceMesh, Topology};
 use crate::regions::{bind_parent_sides, bind_regions, grow_regions, side_regions};
-use crate::skeleton::bones::joint_pairs;
+use crate::skeleton::bones::{joint_pairs, BoneIndex};
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -45,7 +43,10 @@ pub fn decompose(
         .collect();
     let spheres = FaceSpheres::new(mesh);
     let vertex_snap = vertex_snap_distances(mesh, topology, params.snap_fraction);
-    let plans = plan_joints(mesh, &spheres, skeleton, &positions, &overrides, params);
+    let bones = BoneIndex::new(joint_pairs(skeleton, &positions), &positions);
+    let plans = plan_joints(
+        mesh, &spheres, skeleton, &positions, &bones, &overrides, params,
+    );
     let cut_surface = CutSurface {
         mesh,
         topology,
@@ -53,7 +54,7 @@ pub fn decompose(
         vertex_snap: &vertex_snap,
         params,
     };
-    let searches = search_all_cuts(&cut_surface, skeleton, &positions, &plans);
+    let searches = search_all_cuts(&cut_surface, &bones, &plans);
     let placements = place_cuts(
         mesh,
         topology,
@@ -260,19 +261,13 @@ enum Outcome {
 
 /// The cut search of every joint that gets a boundary (in parallel over joints); the
 /// other bones a section must not enclose are all bones not at the joint.
-fn search_all_cuts(
-    surface: &CutSurface,
-    skeleton: &Skeleton,
-    positions: &[DVec3],
-    plans: &[JointPlan],
-) -> Vec<CutSearch> {
-    let bones = BoneIndex::new(joint_pairs(skeleton, positions), positions);
+fn search_all_cuts(surface: &CutSurface, bones: &BoneIndex, plans: &[JointPlan]) -> Vec<CutSearch> {
     plans
         .par_iter()
         .enumerate()
         .map_init(DomainScratch::default, |scratch, (j, plan)| match plan {
             JointPlan::Boundary(frame) | JointPlan::Soft(frame, _) => {
-                find_cut_candidates(surface, j, frame, &bones, scratch)
+                find_cut_candidates(surface, j, frame, bones, scratch)
             }
             JointPlan::Skip(_) | JointPlan::Exclude(_) => CutSearch::default(),
         })

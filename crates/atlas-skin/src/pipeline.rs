@@ -18,7 +18,7 @@ use crate::mesh::inside_out::turn_inside_out_pieces;
 use crate::mesh::weld::DEFAULT_WELD_TOLERANCE;
 use crate::mesh::{weld, Topology, Welded};
 use crate::overlap::{compute_overlaps, OverlapError, OverlapParams, Overlaps};
-use crate::skeleton::bones::{bone_segments, nearest_bone};
+use crate::skeleton::bones::{bone_segments, capped_extensions, nearest_bone, EXTENSION_JOINTS};
 use crate::skeleton::hierarchy::infer_hierarchy;
 use crate::skeleton::placement::{check_placement, decomposition_warnings, PlacementError};
 use crate::weights::blend::Blend;
@@ -230,6 +230,17 @@ pub fn skin(
     let done = run(Stage::Decompose);
     warnings.extend(check_placement(input.skeleton, &welded.mesh.positions)?);
     let skeleton = method_skeleton(input.skeleton, &welded.mesh.positions, &mut warnings);
+    let capped = capped_extensions(&skeleton);
+    if let Some(&first) = capped.first() {
+        warnings.push(format!(
+            "{} leaf joint(s) without a tail (the first: {}) continue their bone past \
+             {EXTENSION_JOINTS} or more other joints: each continuation stops at the \
+             {EXTENSION_JOINTS}th (a rig of many siblings on one line; on no benchmark \
+             character does this happen)",
+            capped.len(),
+            skeleton.names[first as usize]
+        ));
+    }
     let decomposition = decompose(&welded.mesh, &topology, &skeleton, &params.decompose)?;
     warnings.extend(decomposition_warnings(
         &decomposition,

@@ -401,3 +401,77 @@ proptest::proptest! {
         proptest::prop_assert_eq!(d.joints.len(), points.len());
     }
 }
+
+/// Siblings of a root along a tube (each along the bones of the siblings beyond it) and a
+/// twist joint on its parent's bone: another bone passes through each of them, so the cut
+/// search is skipped; the search without the shortcut finds no section either. The top
+/// sibling, which no other bone passes, is searched and cut.
+#[test]
+fn joints_on_another_bone_skip_a_search_that_would_find_nothing() {
+    use atlas_skin::cuts::joint_roles::{plan_joints, JointPlan};
+    use atlas_skin::cuts::plane_search::{find_cut_candidates, search_cut_candidates, CutSurface};
+    use atlas_skin::cuts::plane_section::{vertex_snap_distances, DomainScratch};
+    use atlas_skin::mesh::FaceSpheres;
+    use atlas_skin::skeleton::bones::{joint_pairs, BoneIndex};
+
+    let (mesh, _) = capsule_chain(&[DVec3::ZERO, DVec3::Y * 10.0], &[], 0.5, 16, 80);
+    let mut names = vec!["root".to_string()];
+    let mut parents = vec![NO_PARENT];
+    let mut positions = vec![DVec3::ZERO];
+    for k in 1..=6 {
+        names.push(format!("sibling{k}"));
+        parents.push(0);
+        positions.push(DVec3::Y * k as f64);
+    }
+    // A limb above the siblings: upper (7) → lower (9.5), with a twist joint at 8.
+    names.extend(["upper", "lower", "twist"].map(String::from));
+    parents.extend([6, 7, 7]);
+    positions.extend([7.0, 9.5, 8.0].map(|y| DVec3::Y * y));
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let skeleton = skeleton(&names, &parents, &positions);
+
+    let params = DecomposeParams::default();
+    let topology = Topology::new(&mesh);
+    let spheres = FaceSpheres::new(&mesh);
+    let vertex_snap = vertex_snap_distances(&mesh, &topology, params.snap_fraction);
+    let bones = BoneIndex::new(joint_pairs(&skeleton, &positions), &positions);
+    let overrides = params.overrides(&skeleton).expect("no overrides");
+    let plans = plan_joints(
+        &mesh, &spheres, &skeleton, &positions, &bones, &overrides, &params,
+    );
+    let surface = CutSurface {
+        mesh: &mesh,
+        topology: &topology,
+        spheres: &spheres,
+        vertex_snap: &vertex_snap,
+        params: &params,
+    };
+    let mut scratch = DomainScratch::default();
+    let mut skipped = Vec::new();
+    for (j, plan) in plans.iter().enumerate() {
+        let (JointPlan::Boundary(frame) | JointPlan::Soft(frame, _)) = plan else {
+            continue;
+        };
+        let fast = find_cut_candidates(&surface, j, frame, &bones, &mut scratch);
+        let reference = search_cut_candidates(&surface, j, frame, &bones, &mut scratch);
+        assert_eq!(fast.candidates, reference.candidates, "joint {}", names[j]);
+        if fast.through_joint.is_some() {
+            assert!(reference.enclosing_other_bones > 0, "joint {}", names[j]);
+            skipped.push(names[j]);
+        } else {
+            assert_eq!(fast, reference, "joint {}", names[j]);
+        }
+    }
+    // No bone runs past sibling6 (the highest of the root's), nor through upper or lower.
+    assert_eq!(
+        skipped,
+        ["sibling1", "sibling2", "sibling3", "sibling4", "sibling5", "twist"]
+    );
+
+    let d = run(&mesh, &skeleton);
+    assert!(
+        matches!(status(&d, "twist"), JointStatus::Soft(r) if r.contains("upper -> lower runs through the joint")),
+        "{:?}",
+        status(&d, "twist")
+    );
+}

@@ -5,7 +5,7 @@
 use atlas_skin::fixtures::shapes::{bent_cylinder, capsule_chain};
 use atlas_skin::overlap::OverlapError;
 use atlas_skin::pipeline::{skin, SettingsError, SkinError, SkinInput, SkinParams, Stage};
-use atlas_skin::DecomposeError;
+use atlas_skin::{DecomposeError, Skinned, SurfaceMesh};
 use atlas_skin_runtime::Skeleton;
 use glam::{DVec3, Vec3};
 
@@ -20,6 +20,18 @@ fn input<'a>(
         skeleton,
         end_joints: &[],
     }
+}
+
+/// `mesh` skinned with the default settings, with its positions as stored.
+fn skin_with_defaults(mesh: &SurfaceMesh, skeleton: &Skeleton) -> (Vec<Vec3>, Skinned) {
+    let positions: Vec<Vec3> = mesh.positions.iter().map(|p| p.as_vec3()).collect();
+    let skinned = skin(
+        input(&positions, &mesh.triangles, skeleton),
+        &SkinParams::default(),
+        &mut |_| {},
+    )
+    .expect("skinned");
+    (positions, skinned)
 }
 
 #[test]
@@ -139,13 +151,7 @@ fn weights_along_a_long_bent_tube_rise_and_fall_once_per_joint() {
         SIDES,
         24,
     );
-    let positions: Vec<Vec3> = mesh.positions.iter().map(|p| p.as_vec3()).collect();
-    let skinned = skin(
-        input(&positions, &mesh.triangles, &skeleton),
-        &SkinParams::default(),
-        &mut |_| {},
-    )
-    .expect("skinned");
+    let (_, skinned) = skin_with_defaults(&mesh, &skeleton);
     // Lines of the wall: `capsule_chain` stores a pole, then rings of SIDES vertices from
     // the root's end to the tip's, then the other pole; vertex k of every ring lies on one
     // line along the tube.
@@ -273,4 +279,38 @@ fn no_vertex_takes_weight_from_a_bone_far_beyond_its_nearest() {
         }
         assert!(checked >= positions.len(), "{name}");
     }
+}
+
+/// 40 sibling leaves of one root along a tube (issue 18's rig): the continuations of the
+/// leaves with 8 or more siblings on them stop at the 8th, and the result says so; every
+/// vertex is weighted.
+#[test]
+fn many_siblings_on_one_line_are_skinned_with_a_warning() {
+    let count = 41;
+    let (mesh, _) = capsule_chain(&[DVec3::ZERO, DVec3::Y * 42.0], &[], 0.5, 12, 160);
+    let names = (0..count).map(|k| format!("j{k}")).collect();
+    let parents = (0..count)
+        .map(|k| {
+            if k == 0 {
+                atlas_skin_runtime::NO_PARENT
+            } else {
+                0
+            }
+        })
+        .collect();
+    let joints: Vec<Vec3> = (0..count).map(|k| Vec3::Y * k as f32).collect();
+    let skeleton = Skeleton::from_positions(names, parents, &joints).expect("skeleton");
+    let (positions, skinned) = skin_with_defaults(&mesh, &skeleton);
+    // Leaf j has min(j / 2, 40 − j) siblings on its continuation: j16 to j32 have 8.
+    let warning = skinned
+        .warnings
+        .iter()
+        .find(|w| w.contains("continue their bone"))
+        .expect("a warning");
+    assert!(
+        warning.starts_with("17 leaf joint(s)") && warning.contains("j16"),
+        "{warning}"
+    );
+    assert_eq!(skinned.weights.vertex_count(), positions.len());
+    assert_eq!(skinned.counts.weights.unreachable, 0);
 }

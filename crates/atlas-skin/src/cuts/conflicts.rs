@@ -144,14 +144,21 @@ fn placement_of(
                 names.join(", ")
             )
         }
-        None if search.enclosing_other_bones > 0 => format!(
-            "each of the {} closed sections around the joint also encloses another bone \
-             (a plane across a palm, a foot or the torso)",
-            search.enclosing_other_bones
-        ),
-        None => "no closed cross-section around the joint near it (open surface, \
-                 joint outside, or a section reaching far from the joint)"
-            .into(),
+        None => match search.through_joint {
+            Some((p, c)) => format!(
+                "the bone {} -> {} runs through the joint (or from it) and crosses every \
+                 plane searched there: every closed section around the joint would enclose it",
+                skeleton.names[p], skeleton.names[c]
+            ),
+            None if search.enclosing_other_bones > 0 => format!(
+                "each of the {} closed sections around the joint also encloses another bone \
+                 (a plane across a palm, a foot or the torso)",
+                search.enclosing_other_bones
+            ),
+            None => "no closed cross-section around the joint near it (open surface, \
+                     joint outside, or a section reaching far from the joint)"
+                .into(),
+        },
     };
     Placement::Soft { reason, frame }
 }

@@ -48,12 +48,13 @@ use super::params::{DecomposeParams, Override};
 use crate::geometry::point_segment_distance;
 use crate::mesh::spatial_index::FaceSpheres;
 use crate::mesh::SurfaceMesh;
-use crate::skeleton::bones::{bones_not_at, joint_pairs};
+use crate::skeleton::bones::BoneIndex;
 use crate::skeleton::nearest_point::PointGrid;
 use crate::tolerance::NEGLIGIBLE;
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
 use rayon::prelude::*;
+use std::collections::HashSet;
 
 /// The skeleton's mirror plane: points x with n · x = `offset`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -117,13 +118,14 @@ const PAST_COSINE: f64 = 0.5;
 /// part of the body past it.
 const INTERIOR_RADIUS: f64 = 0.1;
 
-/// Decides, for every joint of `skeleton` (bind positions `positions`), whether it gets a
-/// boundary; `overrides` has one entry per joint.
+/// Decides, for every joint of `skeleton` (bind positions `positions`, bones `bones`),
+/// whether it gets a boundary; `overrides` has one entry per joint.
 pub fn plan_joints(
     mesh: &SurfaceMesh,
     spheres: &FaceSpheres,
     skeleton: &Skeleton,
     positions: &[DVec3],
+    bones: &BoneIndex,
     overrides: &[Option<Override>],
     params: &DecomposeParams,
 ) -> Vec<JointPlan> {
@@ -136,7 +138,7 @@ pub fn plan_joints(
         scale: diagonal(positions).max(f64::MIN_POSITIVE),
         symmetry: infer_symmetry_plane(skeleton, positions, params.symmetry_tolerance),
         orientation: orientation_sign(mesh),
-        bones: joint_pairs(skeleton, positions),
+        bones,
         params,
     };
     (0..skeleton.len())
@@ -157,8 +159,8 @@ struct Rig<'a> {
     symmetry: Option<SymmetryPlane>,
     /// [`orientation_sign`] of the surface.
     orientation: f64,
-    /// [`joint_pairs`] of the skeleton.
-    bones: Vec<(usize, usize)>,
+    /// The skeleton's bones ([`crate::skeleton::bones::joint_pairs`]).
+    bones: &'a BoneIndex,
     params: &'a DecomposeParams,
 }
 
@@ -206,7 +208,7 @@ impl Rig<'_> {
                 self.mesh,
                 self.spheres,
                 &frame,
-                &bones_not_at(&self.bones, self.positions, j),
+                |radius| self.bones.near(j, self.positions[j], radius),
                 self.orientation,
                 self.params.leaf_extent_ratio,
             );
@@ -302,13 +304,14 @@ fn branching_plan(frame: &JointFrame, child_vectors: &[DVec3]) -> Option<JointPl
     None
 }
 
-/// Rule 5: whether the leaf of `frame` owns geometry. `other_bones`: the bones not at the
-/// leaf, as segments; `orientation` as from [`orientation_sign`].
+/// Rule 5: whether the leaf of `frame` owns geometry. `other_bones(radius)`: the bones not
+/// at the leaf within `radius` of it, as segments; `orientation` as from
+/// [`orientation_sign`].
 fn leaf_owns_geometry(
     mesh: &SurfaceMesh,
     spheres: &FaceSpheres,
     frame: &JointFrame,
-    other_bones: &[[DVec3; 2]],
+    other_bones: impl FnOnce(f64) -> Vec<[DVec3; 2]>,
     orientation: f64,
     extent_ratio: f64,
 ) -> bool {
@@ -324,7 +327,11 @@ fn leaf_owns_geometry(
         return false;
     }
     let reach_threshold = LEAF_REACH_RATIO * radius;
-    leaf_reach(mesh, spheres, p, upper, other_bones, 2.0 * reach_threshold) >= reach_threshold
+    // A bone nearer than p to a vertex within ρ of p lies within 2ρ of p (3ρ leaves room
+    // for rounding): the others need no test.
+    let reach_radius = 2.0 * reach_threshold;
+    let near_bones = other_bones(3.0 * reach_radius);
+    leaf_reach(mesh, spheres, p, upper, &near_bones, reach_radius) >= reach_threshold
 }
 
 /// The largest distance from `p` of the surface vertices v within `radius` of it that lie
@@ -449,6 +456,10 @@ pub fn infer_symmetry_plane(
             break;
         }
     }
+    // Equal normals give equal planes: each is tried once (the first kept, so that the
+    // first of equal minima still wins). 100 siblings on one line give one normal.
+    let mut tried = HashSet::new();
+    normals.retain(|n| tried.insert(n.to_array().map(f64::to_bits)));
     let joints = PointGrid::new(positions);
     normals
         .into_iter()

@@ -16,6 +16,9 @@
 
 use crate::geometry::point_segment_distance;
 use glam::DVec3;
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+use std::ops::ControlFlow;
 
 /// Segments per leaf.
 const LEAF: usize = 4;
@@ -188,8 +191,84 @@ impl BoneTree {
     /// ([`point_segment_distance`] ≤ `radius`): the same as a scan of every segment.
     pub fn within(&self, p: DVec3, radius: f64) -> Vec<u32> {
         let mut found = Vec::new();
+        let _: ControlFlow<()> = self.visit_within(p, radius, |key| {
+            found.push(key);
+            ControlFlow::Continue(())
+        });
+        found.sort_unstable();
+        found
+    }
+
+    /// A key of a segment within `radius` of `p` for which `admit(key)` holds, `None` when
+    /// there is none (the same answer as a scan; which key, when several qualify, is the
+    /// first met in the tree's order). Stops at the first: the thousands of sibling bones
+    /// through one point cost one descent.
+    pub fn find_within(&self, p: DVec3, radius: f64, admit: impl Fn(u32) -> bool) -> Option<u32> {
+        match self.visit_within(p, radius, |key| {
+            if admit(key) {
+                ControlFlow::Break(key)
+            } else {
+                ControlFlow::Continue(())
+            }
+        }) {
+            ControlFlow::Break(key) => Some(key),
+            ControlFlow::Continue(()) => None,
+        }
+    }
+
+    /// Calls `visit` with the key and the distance of every segment within `radius` of
+    /// `p`, nearest first (equal distances in any order), until it breaks: the k nearest
+    /// cost about k descents, not a scan.
+    pub fn visit_nearest_first<B>(
+        &self,
+        p: DVec3,
+        radius: f64,
+        mut visit: impl FnMut(u32, f64) -> ControlFlow<B>,
+    ) -> ControlFlow<B> {
+        // (distance, 0 for a node or 1 for a segment, index); distances are non-negative,
+        // so their bits order them.
+        let mut heap: BinaryHeap<Reverse<(u64, u8, u32)>> = BinaryHeap::new();
+        if let Some(root) = self.nodes.first() {
+            heap.push(Reverse((root.distance(p).to_bits(), 0, 0)));
+        }
+        // Boxes are passed over only when clearly farther, as in `visit_within`.
+        let reach = radius * (1.0 + 1e-9);
+        while let Some(Reverse((bits, kind, index))) = heap.pop() {
+            let distance = f64::from_bits(bits);
+            if distance > reach {
+                break;
+            }
+            if kind == 1 {
+                if distance <= radius {
+                    visit(self.items[index as usize].key, distance)?;
+                }
+                continue;
+            }
+            let node = &self.nodes[index as usize];
+            if node.count > 0 {
+                for i in node.first..node.first + node.count {
+                    let d = self.items[i as usize].distance(p);
+                    heap.push(Reverse((d.to_bits(), 1, i)));
+                }
+            } else {
+                for child in [index + 1, node.right] {
+                    let d = self.nodes[child as usize].distance(p);
+                    heap.push(Reverse((d.to_bits(), 0, child)));
+                }
+            }
+        }
+        ControlFlow::Continue(())
+    }
+
+    /// Calls `visit` with the key of every segment within `radius` of `p` until it breaks.
+    fn visit_within<B>(
+        &self,
+        p: DVec3,
+        radius: f64,
+        mut visit: impl FnMut(u32) -> ControlFlow<B>,
+    ) -> ControlFlow<B> {
         if self.nodes.is_empty() {
-            return found;
+            return ControlFlow::Continue(());
         }
         // Boxes are skipped only when clearly farther: the exact test is the segment's.
         let reach = radius * (1.0 + 1e-9);
@@ -201,17 +280,14 @@ impl BoneTree {
             }
             if node.count > 0 {
                 let leaf = &self.items[node.first as usize..(node.first + node.count) as usize];
-                found.extend(
-                    leaf.iter()
-                        .filter(|item| item.distance(p) <= radius)
-                        .map(|item| item.key),
-                );
+                for item in leaf.iter().filter(|item| item.distance(p) <= radius) {
+                    visit(item.key)?;
+                }
             } else {
                 stack.extend([index + 1, node.right]);
             }
         }
-        found.sort_unstable();
-        found
+        ControlFlow::Continue(())
     }
 }
 
@@ -362,6 +438,21 @@ mod tests {
                     })
                     .collect();
                 assert_eq!(tree.within(p, radius), near);
+                // A filter that admits only odd keys: found when a scan finds one.
+                let odd = |k: u32| k % 2 == 1;
+                let found = tree.find_within(p, radius, odd);
+                assert_eq!(found.is_some(), near.iter().any(|&k| odd(k)));
+                assert!(found.is_none_or(|k| odd(k) && near.contains(&k)));
+                // Nearest first: the distances of a scan, sorted.
+                let mut visited = Vec::new();
+                let _: ControlFlow<()> = tree.visit_nearest_first(p, radius, |k, d| {
+                    visited.push((k, d));
+                    ControlFlow::Continue(())
+                });
+                assert!(visited.windows(2).all(|w| w[0].1 <= w[1].1));
+                let mut keys: Vec<u32> = visited.iter().map(|&(k, _)| k).collect();
+                keys.sort_unstable();
+                assert_eq!(keys, near);
             }
         }
     }
