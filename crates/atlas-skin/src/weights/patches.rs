@@ -24,6 +24,7 @@
 
 use crate::decomposition::Decomposition;
 use crate::mesh::Topology;
+use crate::skeleton::bone_tree::{BoneTree, Keys, Split};
 use crate::skeleton::bones::bone_segments;
 use crate::weights::blend::beta;
 use crate::weights::ownership::{Ownership, OwnershipBones};
@@ -31,6 +32,7 @@ use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::collections::{HashMap, HashSet, VecDeque};
+use std::ops::ControlFlow;
 
 /// Patch radius as a multiple of the median spacing of the region's leaf tails.
 pub const RADIUS_PER_SPACING: f64 = 3.0;
@@ -82,10 +84,20 @@ pub fn leaf_patches(
         .collect();
     let radii = region_radii(skeleton, &heads, &candidates);
     let bones = OwnershipBones::new(skeleton, &decomposition.joints, &bone_segments(skeleton));
+    let positions = &decomposition.surface.positions;
+    // The vertices of each region with a patch in a tree: the seed of each patch by a
+    // descent, not a scan of the region per leaf (a region with thousands of leaves).
+    let mut patched: Vec<u32> = radii.keys().copied().collect();
+    patched.sort_unstable();
+    let trees: HashMap<u32, BoneTree> = patched
+        .par_iter()
+        .map(|&r| (r, vertex_tree(positions, &region_vertices[r as usize])))
+        .collect();
     candidates
         .par_iter()
         .filter_map(|&(j, region, tail)| {
             let radius = *radii.get(&region)?;
+            let seed = nearest_vertex(trees.get(&region)?, tail)?;
             let owner = Ownership::new(&bones, j, region, 0.5 * radius);
             let share = |p: DVec3| {
                 let a = p.distance(tail);
@@ -95,10 +107,10 @@ pub fn leaf_patches(
                 beta(1.0 - a / radius) * owner.at(p)
             };
             let shares = flood(
-                &decomposition.surface.positions,
+                positions,
                 &decomposition.topology,
                 &region_vertices[region as usize],
-                |p| p.distance(tail),
+                seed,
                 share,
             );
             (!shares.is_empty()).then_some(Patch {
@@ -120,13 +132,22 @@ fn region_radii(
     candidates: &[(usize, u32, DVec3)],
 ) -> HashMap<u32, f64> {
     let mut spacings: HashMap<u32, Vec<f64>> = HashMap::new();
+    if candidates.is_empty() {
+        return HashMap::new();
+    }
+    // Every joint's position and tail as points keyed by the joint: the nearest of another
+    // joint by a descent, not a scan of every joint per leaf.
+    let points = BoneTree::new(
+        (0..skeleton.len()).flat_map(|k| {
+            let key = k as u32;
+            std::iter::once((key, heads[k], heads[k]))
+                .chain(skeleton.tails[k].map(|t| (key, t.as_dvec3(), t.as_dvec3())))
+        }),
+        Split::Space,
+    );
     for &(j, region, tail) in candidates {
-        let others = (0..skeleton.len())
-            .filter(|&k| k != j)
-            .flat_map(|k| std::iter::once(heads[k]).chain(skeleton.tails[k].map(|t| t.as_dvec3())));
-        let spacing = others
-            .map(|p| p.distance(tail))
-            .fold(f64::INFINITY, f64::min);
+        let j = j as u32;
+        let spacing = points.nearest_distance(tail, Keys::Outside(j, j + 1), |_, _| true);
         if spacing.is_finite() {
             spacings.entry(region).or_default().push(spacing);
         }
@@ -140,21 +161,41 @@ fn region_radii(
         .collect()
 }
 
-/// The vertices reached along edges from the vertex of `allowed` nearest to the bone
-/// (by `distance`) through vertices of `allowed` with `share > 0`, with their shares, by
-/// increasing vertex.
+/// The vertices `vertices` as points keyed by their index, in a tree.
+fn vertex_tree(positions: &[DVec3], vertices: &[u32]) -> BoneTree {
+    BoneTree::new(
+        vertices.iter().map(|&v| {
+            let p = positions[v as usize];
+            (v, p, p)
+        }),
+        Split::Space,
+    )
+}
+
+/// The vertex of `tree` ([`vertex_tree`]) nearest to `p`, the smallest index among equally
+/// near ones; `None` for an empty tree.
+fn nearest_vertex(tree: &BoneTree, p: DVec3) -> Option<u32> {
+    let mut nearest: Option<(f64, u32)> = None;
+    let _: ControlFlow<()> = tree.visit_nearest_first(p, f64::INFINITY, |v, d| match nearest {
+        Some((best, _)) if d > best => ControlFlow::Break(()),
+        Some((best, w)) if d == best && v > w => ControlFlow::Continue(()),
+        _ => {
+            nearest = Some((d, v));
+            ControlFlow::Continue(())
+        }
+    });
+    nearest.map(|(_, v)| v)
+}
+
+/// The vertices reached along edges from `seed` through vertices of `allowed` with
+/// `share > 0`, with their shares, by increasing vertex.
 fn flood(
     positions: &[DVec3],
     topology: &Topology,
     allowed: &[u32],
-    distance: impl Fn(DVec3) -> f64,
+    seed: u32,
     share: impl Fn(DVec3) -> f64,
 ) -> Vec<(u32, f64)> {
-    let Some(&seed) = allowed.iter().min_by(|&&a, &&b| {
-        distance(positions[a as usize]).total_cmp(&distance(positions[b as usize]))
-    }) else {
-        return Vec::new();
-    };
     let mut seen = HashSet::new();
     let mut shares = Vec::new();
     let mut queue = VecDeque::from([seed]);
@@ -173,4 +214,43 @@ fn flood(
     }
     shares.sort_unstable_by_key(|&(v, _)| v);
     shares
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A deterministic scatter of points in the unit cube, with repeats (ties).
+    fn scatter(n: usize) -> Vec<DVec3> {
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut points: Vec<DVec3> = (0..n).map(|_| DVec3::new(next(), next(), next())).collect();
+        for k in (0..n).step_by(7) {
+            points[k] = points[k / 2];
+        }
+        points
+    }
+
+    #[test]
+    fn the_nearest_vertex_from_the_tree_is_the_scan_s_first_nearest() {
+        let positions = scatter(600);
+        let vertices: Vec<u32> = (0..600).filter(|v| v % 3 != 1).collect();
+        let tree = vertex_tree(&positions, &vertices);
+        for p in scatter(200).into_iter().chain(positions.iter().copied()) {
+            let scan = vertices.iter().copied().min_by(|&a, &b| {
+                p.distance(positions[a as usize])
+                    .total_cmp(&p.distance(positions[b as usize]))
+            });
+            assert_eq!(nearest_vertex(&tree, p), scan, "{p}");
+        }
+        assert_eq!(
+            nearest_vertex(&vertex_tree(&positions, &[]), DVec3::ZERO),
+            None
+        );
+    }
 }
