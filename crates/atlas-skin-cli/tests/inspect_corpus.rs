@@ -111,17 +111,7 @@ fn robotexpressive_every_mesh_is_read_counted_and_kept() {
     );
 
     let dir = support::out_dir("inspect-robot");
-    let glb = dir.join("robot.glb");
-    let json = dir.join("robot.json");
-    atlas_skin_ok(&[
-        OsString::from("skin"),
-        input.clone().into(),
-        "-o".into(),
-        glb.clone().into(),
-        "--report".into(),
-        json.clone().into(),
-    ]);
-    let skin_report: Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    let (glb, skin_report) = support::skin_with_report(&input, &dir, "robot");
     assert_eq!(skin_report["counts"]["vertices"], 7214);
     let written: Value = {
         let bytes = std::fs::read(&glb).unwrap();

@@ -18,6 +18,7 @@ use crate::cuts::plane_section::{diameter, vertex_snap_distances, DomainScratch}
 use crate::cuts::split::split_along_curves;
 use crate::decomposition::{Boundary, BoundaryKind, Decomposition, JointDecision, JointStatus};
 use crate::mesh::{FaceSpheres, SurfaceMesh, Topology};
+use crate::regions::holding::HoldingRegions;
 use crate::regions::{bind_parent_sides, bind_regions, grow_regions, side_regions};
 use crate::skeleton::bones::{joint_pairs, BoneIndex};
 use atlas_skin_runtime::Skeleton;
@@ -97,6 +98,22 @@ pub fn decompose(
             .collect()
     };
     let cut_parent = sides(false);
+    let owns_skin: Vec<bool> = plans
+        .iter()
+        .map(|plan| !matches!(plan, JointPlan::Exclude(_)))
+        .collect();
+    // The faces of the split surface are indexed only when some joint is soft.
+    let holders = outcomes
+        .iter()
+        .any(|o| matches!(o, Outcome::Soft { .. }))
+        .then(|| HoldingRegions::new(&surface, &face_region));
+    let holding = |j: usize, parent_region: Option<u32>| match (&outcomes[j], &holders) {
+        (Outcome::Soft { frame, .. }, Some(holders)) => {
+            let (_, _, diameter) = section_geometry(frame, searches[j].candidates.first());
+            holders.holding_region(frame.position, diameter, parent_region)
+        }
+        _ => parent_region,
+    };
     let (joint_region, mut regions) = bind_regions(
         &surface,
         &face_region,
@@ -105,13 +122,14 @@ pub fn decompose(
         &positions,
         &sides(true),
         &cut_parent,
+        holding,
     );
+    drop(holders);
 
     let (boundaries, mut joints) = decide_joints(skeleton, outcomes, &joint_region, &searches);
-    for (decision, plan) in joints.iter_mut().zip(&plans) {
-        decision.owns_skin = !matches!(plan, JointPlan::Exclude(_));
+    for (decision, &owns) in joints.iter_mut().zip(&owns_skin) {
+        decision.owns_skin = owns;
     }
-    let owns_skin: Vec<bool> = joints.iter().map(|d| d.owns_skin).collect();
     bind_parent_sides(&mut regions, skeleton, &cut_parent, &owns_skin);
     Ok(Decomposition {
         topology: split_topology,
@@ -286,16 +304,7 @@ fn boundary_geometry(
     parent_region: u32,
     child_region: u32,
 ) -> Boundary {
-    let (normal, perimeter, diameter) = match section {
-        Some(c) => (c.plane.normal, c.perimeter, diameter(&c.points)),
-        None => {
-            let r = frame.surface_distance;
-            let normal = (frame.upper + frame.lower)
-                .try_normalize()
-                .unwrap_or(frame.upper);
-            (normal, std::f64::consts::TAU * r, 2.0 * r)
-        }
-    };
+    let (normal, perimeter, diameter) = section_geometry(frame, section);
     Boundary {
         joint: joint as u32,
         kind,
@@ -305,6 +314,20 @@ fn boundary_geometry(
         diameter,
         parent_region,
         child_region,
+    }
+}
+
+/// (normal, perimeter, diameter) of a boundary with `section` (see [`boundary_geometry`]).
+fn section_geometry(frame: &JointFrame, section: Option<&CutCandidate>) -> (DVec3, f64, f64) {
+    match section {
+        Some(c) => (c.plane.normal, c.perimeter, diameter(&c.points)),
+        None => {
+            let r = frame.surface_distance;
+            let normal = (frame.upper + frame.lower)
+                .try_normalize()
+                .unwrap_or(frame.upper);
+            (normal, std::f64::consts::TAU * r, 2.0 * r)
+        }
     }
 }
 

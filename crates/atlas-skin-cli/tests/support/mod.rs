@@ -28,6 +28,26 @@ pub fn atlas_skin_ok<A: AsRef<OsStr>>(args: &[A]) -> Output {
     output
 }
 
+/// Runs `atlas-skin skin INPUT -o DIR/STEM.glb --report DIR/STEM.json` and returns the
+/// written glb's path and the report.
+pub fn skin_with_report(input: &Path, dir: &Path, stem: &str) -> (PathBuf, serde_json::Value) {
+    let glb = dir.join(format!("{stem}.glb"));
+    let json = dir.join(format!("{stem}.json"));
+    let args: [&OsStr; 6] = [
+        "skin".as_ref(),
+        input.as_ref(),
+        "-o".as_ref(),
+        glb.as_ref(),
+        "--report".as_ref(),
+        json.as_ref(),
+    ];
+    atlas_skin_ok(&args);
+    let report =
+        std::fs::read(&json).unwrap_or_else(|e| panic!("cannot read {}: {e}", json.display()));
+    let report = serde_json::from_slice(&report).expect("the report is JSON");
+    (glb, report)
+}
+
 /// A fresh, empty output folder for one test under the target's test temp dir.
 pub fn out_dir(test: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))

@@ -19,6 +19,8 @@
 //! skeleton. Outputs: the region of every face, the regions on each side of every cut, the
 //! region of every joint and the joints each region holds ([`Region`]).
 
+pub mod holding;
+
 use crate::cuts::plane_section::Plane;
 use crate::decomposition::Region;
 use crate::mesh::{SurfaceMesh, Topology};
@@ -110,8 +112,16 @@ pub fn side_regions(
 /// - `cut_child`: #J child region of every joint with a separating cut, `None` otherwise.
 /// - `cut_parent`: #J parent region of the same cuts.
 /// - `positions`: #J bind positions.
+/// - `holding(j, r)`: the region that holds joint j, which has no cut, when its parent
+///   lies in region r ([`holding::HoldingRegions`] for a soft joint, r itself otherwise).
+///
+/// A region whose joint nearest the root lies in it because its parent's region does not
+/// reach it (`holding` moved it there) continues that region across the gap between their
+/// pieces: it is bound to the joint the parent's region is bound to, and the joints it
+/// holds act in it as soft boundaries.
 ///
 /// Returns (#J region of each joint, `None` when the surface is empty; the regions).
+#[allow(clippy::too_many_arguments)]
 pub fn bind_regions(
     mesh: &SurfaceMesh,
     face_region: &[u32],
@@ -120,13 +130,14 @@ pub fn bind_regions(
     positions: &[DVec3],
     cut_child: &[Option<u32>],
     cut_parent: &[Option<u32>],
+    holding: impl Fn(usize, Option<u32>) -> Option<u32>,
 ) -> (Vec<Option<u32>>, Vec<Region>) {
     let order = skeleton.topological_order();
     let mut joint_region: Vec<Option<u32>> = vec![None; skeleton.len()];
     for &j in &order {
         joint_region[j] = match (cut_child[j], skeleton.parent(j)) {
             (Some(child), _) => Some(child),
-            (None, Some(p)) => joint_region[p],
+            (None, Some(p)) => holding(j, joint_region[p]),
             (None, None) => order
                 .iter()
                 .filter(|&&k| skeleton.ancestors(k).any(|a| a == j))
@@ -161,6 +172,20 @@ pub fn bind_regions(
         {
             let bound = list.remove(k);
             list.insert(0, bound);
+        }
+    }
+    // Regions whose first joint was moved there, in the order of those joints: the
+    // parent's region, holding an earlier joint, is bound before.
+    for &j in &order {
+        let (Some(r), Some(p)) = (joint_region[j], skeleton.parent(j)) else {
+            continue;
+        };
+        let parent_region = joint_region[p].filter(|&q| q != r);
+        let first = joints[r as usize].first() == Some(&(j as u32));
+        if let (true, None, Some(q)) = (first, cut_child[j], parent_region) {
+            if let Some(&bound) = joints[q as usize].first() {
+                joints[r as usize].insert(0, bound);
+            }
         }
     }
     let regions = joints
@@ -241,6 +266,54 @@ mod tests {
             faces: 1,
             vertices: 3,
         }
+    }
+
+    #[test]
+    fn a_region_holding_a_joint_its_parents_region_does_not_reach_is_bound_like_that_region() {
+        // root (0) → forearm (1, cut: region 1) → palm (2, soft) → finger (3, soft), and
+        // root → head (4, soft). Region 0 is the root's, region 2 a separate hand piece
+        // around the palm, region 3 a piece around nothing.
+        let skeleton = Skeleton::from_positions(
+            ["root", "forearm", "palm", "finger", "head"]
+                .map(String::from)
+                .to_vec(),
+            vec![NO_PARENT, 0, 1, 2, 0],
+            &[Vec3::ZERO, Vec3::X, 2.0 * Vec3::X, 3.0 * Vec3::X, Vec3::Y],
+        )
+        .expect("a valid skeleton");
+        let mesh = SurfaceMesh {
+            positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y],
+            triangles: vec![[0, 1, 2]; 4],
+        };
+        let face_region = [0, 1, 2, 3];
+        let cut_child = [None, Some(1), None, None, None];
+        let cut_parent = [None, Some(0), None, None, None];
+        // The palm lies in the hand piece, its finger follows it there; the head stays.
+        let holding = |j: usize, parent_region: Option<u32>| match j {
+            2 => Some(2),
+            _ => parent_region,
+        };
+        let (joint_region, regions) = bind_regions(
+            &mesh,
+            &face_region,
+            4,
+            &skeleton,
+            &skeleton
+                .bind_positions()
+                .iter()
+                .map(|p| p.as_dvec3())
+                .collect::<Vec<_>>(),
+            &cut_child,
+            &cut_parent,
+            holding,
+        );
+        assert_eq!(joint_region, [Some(0), Some(1), Some(2), Some(2), Some(0)]);
+        assert_eq!(regions[0].joints, vec![0, 4]);
+        assert_eq!(regions[1].joints, vec![1]);
+        // The hand piece continues the forearm's region: bound to the forearm, the palm
+        // and the finger act in it.
+        assert_eq!(regions[2].joints, vec![1, 2, 3]);
+        assert!(regions[3].joints.is_empty());
     }
 
     #[test]

@@ -1,0 +1,126 @@
+//! The region that holds a soft joint on a surface of several pieces.
+//!
+//! On one connected surface a joint without a cut lies in its parent's region: no cut
+//! separates them (§3.2). On a character made of pieces the parent's region can lie on
+//! another piece than the one around the joint (a dress holding the shoulders and the
+//! head while the root's region is the legs' piece; a hand piece holding the palm joints
+//! while the forearm's cut left their parent's region on the sleeve). The joint's soft
+//! boundary then finds none of its region near the joint and carries no weight
+//! ([`crate::weights::soft_sides`]), and the piece around it moves with whatever joint
+//! the rules for regions without joints give it.
+//!
+//! The rule: with d_N the distance from the joint to the nearest face of the surface and
+//! D the diameter of the joint's section (its best closed section, else 2 d_N, as the
+//! soft boundary's), the parent's region holds the joint when one of its faces lies
+//! within d_N + ρ D of it (ρ = [`REACH`]): it reaches the joint's cross-section. Otherwise
+//! the region of the nearest face holds it ([`super::bind_regions`] says what that region
+//! is bound to).
+
+use crate::mesh::{FaceSpheres, NearestPoint, SurfaceMesh};
+use glam::DVec3;
+
+/// ρ: how far past the nearest surface, in section diameters, the parent's region may lie
+/// and still hold the joint. Measured over the benchmark and the corpus (docs/pieces.md,
+/// "Soft joints on another piece"): 0.5, 1, 2 and 4 change 15, 11, 10 and 6 characters;
+/// 2 gives the lowest average deform mean, max and weight L1.
+pub const REACH: f64 = 2.0;
+
+/// The faces of the split surface with their regions, for [`Self::holding_region`].
+pub struct HoldingRegions<'a> {
+    mesh: &'a SurfaceMesh,
+    face_region: &'a [u32],
+    spheres: FaceSpheres,
+}
+
+impl<'a> HoldingRegions<'a> {
+    /// Indexes the faces of `mesh` (the split surface), `face_region` the region of each.
+    pub fn new(mesh: &'a SurfaceMesh, face_region: &'a [u32]) -> Self {
+        Self {
+            mesh,
+            face_region,
+            spheres: FaceSpheres::new(mesh),
+        }
+    }
+
+    /// The region holding a soft joint at `position` whose section has diameter
+    /// `diameter` when its parent lies in `parent_region` (module documentation):
+    /// `parent_region` when it reaches the joint, else the region of the nearest face.
+    pub fn holding_region(
+        &self,
+        position: DVec3,
+        diameter: f64,
+        parent_region: Option<u32>,
+    ) -> Option<u32> {
+        let Some(nearest) = self.spheres.nearest_point(self.mesh, position) else {
+            return parent_region;
+        };
+        let nearest_region = self.face_region[nearest.face as usize];
+        let Some(parent) = parent_region else {
+            return Some(nearest_region);
+        };
+        if parent == nearest_region {
+            return Some(parent);
+        }
+        let reach = nearest.distance + REACH * diameter.max(0.0);
+        let reaches = self
+            .spheres
+            .faces_near(position, reach)
+            .into_iter()
+            .filter(|&f| self.face_region[f as usize] == parent)
+            .any(|f| NearestPoint::on_face(self.mesh, f, position).distance <= reach);
+        Some(if reaches { parent } else { nearest_region })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fixtures::shapes::icosphere;
+
+    /// Two pieces: a ball of radius 1 at the origin (region 0) and one of radius 0.3 at
+    /// x = 5 (region 1).
+    fn two_balls() -> (SurfaceMesh, Vec<u32>) {
+        let mut mesh = icosphere(1.0, 2);
+        let small = icosphere(0.3, 2);
+        let offset = mesh.vertex_count() as u32;
+        let first_faces = mesh.triangle_count();
+        mesh.positions.extend(
+            small
+                .positions
+                .iter()
+                .map(|&p| p + DVec3::new(5.0, 0.0, 0.0)),
+        );
+        mesh.triangles
+            .extend(small.triangles.iter().map(|t| t.map(|v| v + offset)));
+        let face_region = (0..mesh.triangle_count())
+            .map(|f| u32::from(f >= first_faces))
+            .collect();
+        (mesh, face_region)
+    }
+
+    #[test]
+    fn a_joint_inside_another_piece_than_its_parents_region_is_held_by_that_piece() {
+        let (mesh, face_region) = two_balls();
+        let holders = HoldingRegions::new(&mesh, &face_region);
+        // At the centre of the small ball: its surface lies about 0.3 away, the big
+        // ball's about 4: d_N + ρ D = 0.3 + 2 × 0.6 falls short of it.
+        let centre = DVec3::new(5.0, 0.0, 0.0);
+        assert_eq!(holders.holding_region(centre, 0.6, Some(0)), Some(1));
+        // A section wide enough to reach the big ball keeps the parent's region:
+        // 0.3 + 2 × 2 ≥ 4.
+        assert_eq!(holders.holding_region(centre, 2.0, Some(0)), Some(0));
+        // Its own region, or none, is always answered by the nearest piece.
+        assert_eq!(holders.holding_region(centre, 0.6, Some(1)), Some(1));
+        assert_eq!(holders.holding_region(centre, 0.6, None), Some(1));
+        // Inside the big ball the parent's region holds the joint.
+        assert_eq!(holders.holding_region(DVec3::ZERO, 0.6, Some(0)), Some(0));
+    }
+
+    #[test]
+    fn a_surface_without_faces_keeps_the_parents_region() {
+        let mesh = SurfaceMesh::default();
+        let holders = HoldingRegions::new(&mesh, &[]);
+        assert_eq!(holders.holding_region(DVec3::ZERO, 1.0, Some(3)), Some(3));
+        assert_eq!(holders.holding_region(DVec3::ZERO, 1.0, None), None);
+    }
+}
