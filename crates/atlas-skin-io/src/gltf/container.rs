@@ -347,28 +347,30 @@ fn load_images(
 /// A GLB file holding `json` and, when `bin` is not empty, a BIN chunk. Chunks are padded
 /// to 4 bytes: JSON with spaces, BIN with zeros (glTF 2.0 §4.4.3).
 ///
-/// The JSON is serialised straight into the file's buffer after a placeholder header (the
-/// compact form `Value`'s `Display` writes, without going through a `String` and the
-/// formatter), and the lengths are filled in after.
+/// The JSON is serialised into bytes directly (the compact form `Value`'s `Display`
+/// writes, without going through the formatter and a `String`), and the file is
+/// allocated once at its final size (growing it would copy the BIN chunk).
 pub(crate) fn glb_bytes(json: &Value, bin: &[u8]) -> Vec<u8> {
-    let header = GLB_HEADER_BYTES + CHUNK_HEADER_BYTES;
-    let mut out = Vec::with_capacity(header + bin.len() + CHUNK_HEADER_BYTES + 4);
-    out.resize(header, 0);
-    serde_json::to_writer(&mut out, json).expect("a JSON value serialises into memory");
-    out.resize(out.len().next_multiple_of(4), b' ');
-    let json_chunk_len = out.len() - header;
+    let mut json_chunk = serde_json::to_vec(json).expect("a JSON value serialises into memory");
+    json_chunk.resize(json_chunk.len().next_multiple_of(4), b' ');
+    let bin_chunk_len = bin.len().next_multiple_of(4);
+    let mut total = GLB_HEADER_BYTES + CHUNK_HEADER_BYTES + json_chunk.len();
     if !bin.is_empty() {
-        out.extend_from_slice(&(bin.len().next_multiple_of(4) as u32).to_le_bytes());
+        total += CHUNK_HEADER_BYTES + bin_chunk_len;
+    }
+    let mut out = Vec::with_capacity(total);
+    out.extend_from_slice(GLB_MAGIC);
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(json_chunk.len() as u32).to_le_bytes());
+    out.extend_from_slice(&CHUNK_JSON.to_le_bytes());
+    out.extend_from_slice(&json_chunk);
+    if !bin.is_empty() {
+        out.extend_from_slice(&(bin_chunk_len as u32).to_le_bytes());
         out.extend_from_slice(&CHUNK_BIN.to_le_bytes());
         out.extend_from_slice(bin);
-        out.resize(out.len().next_multiple_of(4), 0);
+        out.resize(total, 0);
     }
-    let total = out.len();
-    out[..4].copy_from_slice(GLB_MAGIC);
-    out[4..8].copy_from_slice(&2u32.to_le_bytes());
-    out[8..12].copy_from_slice(&(total as u32).to_le_bytes());
-    out[12..16].copy_from_slice(&(json_chunk_len as u32).to_le_bytes());
-    out[16..20].copy_from_slice(&CHUNK_JSON.to_le_bytes());
     out
 }
 
