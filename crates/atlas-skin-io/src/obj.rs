@@ -1,7 +1,7 @@
 //! Wavefront OBJ meshes: `v` positions and `f` polygons, fan-triangulated, optionally only
 //! the faces of one `g`/`o` group.
 
-use crate::text::{check_index, parse_field, parse_point, read_text};
+use crate::text::{check_index, is_plain_ascii, parse_field, parse_point, read_text, Words};
 use crate::{IoError, TriangleMesh};
 use std::path::Path;
 
@@ -14,19 +14,23 @@ use std::path::Path;
 /// group is an error listing the file's groups.
 pub fn read(path: &Path, group: Option<&str>) -> Result<TriangleMesh, IoError> {
     let text = read_text(path)?;
+    let ascii = is_plain_ascii(&text);
     let mut mesh = TriangleMesh::default();
     let mut groups: Vec<String> = Vec::new();
     let mut in_group = group.is_none();
+    // The corners of the current face (one buffer for every face).
+    let mut corners: Vec<u32> = Vec::new();
     for (index, raw) in text.lines().enumerate() {
         let line = index + 1;
         let content = raw.split('#').next().unwrap_or_default();
-        let mut tokens = content.split_whitespace();
+        let mut tokens = Words::of(content, ascii);
         match tokens.next() {
             Some("v") => mesh.positions.push(parse_point(path, line, &mut tokens)?),
             Some("f") => {
-                let corners = tokens
-                    .map(|corner| parse_corner(path, line, corner, mesh.positions.len()))
-                    .collect::<Result<Vec<u32>, IoError>>()?;
+                corners.clear();
+                for corner in tokens {
+                    corners.push(parse_corner(path, line, corner, mesh.positions.len())?);
+                }
                 if corners.len() < 3 {
                     return Err(IoError::syntax(
                         path,

@@ -51,6 +51,41 @@ pub(crate) fn read_text(path: &Path) -> Result<String, IoError> {
     })
 }
 
+/// Whether `text` is ASCII without vertical tabs: then [`str::split_ascii_whitespace`]
+/// splits it exactly as [`str::split_whitespace`] does (U+000B is the one ASCII character
+/// that only the latter takes for a separator), byte by byte instead of char by char.
+pub(crate) fn is_plain_ascii(text: &str) -> bool {
+    text.is_ascii() && !text.contains('\x0B')
+}
+
+/// The whitespace-separated words of a line: split byte by byte when the file is
+/// [`is_plain_ascii`], by Unicode whitespace otherwise (the same words).
+pub(crate) enum Words<'a> {
+    Ascii(std::str::SplitAsciiWhitespace<'a>),
+    Unicode(std::str::SplitWhitespace<'a>),
+}
+
+impl<'a> Words<'a> {
+    pub(crate) fn of(line: &'a str, plain_ascii: bool) -> Self {
+        if plain_ascii {
+            Self::Ascii(line.split_ascii_whitespace())
+        } else {
+            Self::Unicode(line.split_whitespace())
+        }
+    }
+}
+
+impl<'a> Iterator for Words<'a> {
+    type Item = &'a str;
+
+    fn next(&mut self) -> Option<&'a str> {
+        match self {
+            Self::Ascii(words) => words.next(),
+            Self::Unicode(words) => words.next(),
+        }
+    }
+}
+
 /// Parses the JSON document at `path` into `T`; syntax and shape errors carry the line.
 pub(crate) fn read_json<T: DeserializeOwned>(path: &Path) -> Result<T, IoError> {
     let text = read_text(path)?;
@@ -257,6 +292,20 @@ mod tests {
             error.contains("unexpected end of file, expected z"),
             "{error}"
         );
+    }
+
+    #[test]
+    fn ascii_words_are_the_unicode_words_of_plain_ascii() {
+        let line = " v\t1.5  -2\x0C3\r f 1/2/3 ";
+        assert!(is_plain_ascii(line));
+        let ascii: Vec<&str> = Words::of(line, true).collect();
+        assert_eq!(ascii, line.split_whitespace().collect::<Vec<_>>());
+        assert_eq!(ascii, ["v", "1.5", "-2", "3", "f", "1/2/3"]);
+        // A vertical tab or a non-ASCII space separates only as Unicode whitespace.
+        for line in ["1\x0B2", "1\u{A0}2"] {
+            assert!(!is_plain_ascii(line));
+            assert_eq!(Words::of(line, false).collect::<Vec<_>>(), ["1", "2"]);
+        }
     }
 
     #[test]

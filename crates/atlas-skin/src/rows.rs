@@ -57,7 +57,7 @@ impl<T: Copy + Default> Rows<T> {
 impl<T: Copy + Default> Rows<T> {
     /// [`Rows::group`] of the entries `k` in `0..count` whose `key(k)` is some row index
     /// (`< n`), with value `value(k)`: the same rows, from plain index loops (no iterator
-    /// to clone and walk twice), for the large groupings of the topology.
+    /// to clone and walk twice), for large groupings (the duplicate faces of a mesh).
     pub fn group_indexed(
         n: usize,
         count: usize,

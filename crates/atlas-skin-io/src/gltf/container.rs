@@ -346,8 +346,12 @@ fn load_images(
 
 /// A GLB file holding `json` and, when `bin` is not empty, a BIN chunk. Chunks are padded
 /// to 4 bytes: JSON with spaces, BIN with zeros (glTF 2.0 §4.4.3).
+///
+/// The JSON is serialised into bytes directly (the compact form `Value`'s `Display`
+/// writes, without going through the formatter and a `String`), and the file is
+/// allocated once at its final size (growing it would copy the BIN chunk).
 pub(crate) fn glb_bytes(json: &Value, bin: &[u8]) -> Vec<u8> {
-    let mut json_chunk = json.to_string().into_bytes();
+    let mut json_chunk = serde_json::to_vec(json).expect("a JSON value serialises into memory");
     json_chunk.resize(json_chunk.len().next_multiple_of(4), b' ');
     let bin_chunk_len = bin.len().next_multiple_of(4);
     let mut total = GLB_HEADER_BYTES + CHUNK_HEADER_BYTES + json_chunk.len();

@@ -13,7 +13,7 @@
 use crate::cuts::plane_section::{CrossingPoint, SectionCurve};
 use crate::mesh::{SurfaceMesh, Topology};
 use crate::tolerance::FLAT;
-use std::collections::HashMap;
+use rustc_hash::FxHashMap;
 
 /// The surface with the curves inserted.
 #[derive(Debug, Clone)]
@@ -35,9 +35,9 @@ pub fn split_along_curves(
 ) -> SplitSurface {
     let mut positions = mesh.positions.clone();
     // Per crossed edge: (t from edges[e][0], new vertex) of every interior crossing.
-    let mut edge_points: HashMap<u32, Vec<(f64, u32)>> = HashMap::new();
+    let mut edge_points: FxHashMap<u32, Vec<(f64, u32)>> = FxHashMap::default();
     // Per face: the chords drawn in it, as vertex pairs of the split surface.
-    let mut face_chords: HashMap<u32, Vec<[u32; 2]>> = HashMap::new();
+    let mut face_chords: FxHashMap<u32, Vec<[u32; 2]>> = FxHashMap::default();
     let mut loops = Vec::with_capacity(curves.len());
     for curve in curves {
         let vertices: Vec<u32> = curve
@@ -69,15 +69,24 @@ pub fn split_along_curves(
         loops.push(curve_loop);
     }
 
+    // The faces a curve meets: those with a chord or around an edge with a new point (the
+    // others are copied without a look-up).
+    let mut met = vec![false; mesh.triangle_count()];
+    for &e in edge_points.keys() {
+        for &f in topology.faces_of_edge(e as usize) {
+            met[f as usize] = true;
+        }
+    }
+    for &f in face_chords.keys() {
+        met[f as usize] = true;
+    }
     let mut triangles = Vec::with_capacity(mesh.triangle_count() + 4 * edge_points.len());
     for (f, &t) in mesh.triangles.iter().enumerate() {
-        let edges = topology.face_edges[f];
-        if !edges.iter().any(|e| edge_points.contains_key(e))
-            && !face_chords.contains_key(&(f as u32))
-        {
+        if !met[f] {
             triangles.push(t);
             continue;
         }
+        let edges = topology.face_edges[f];
         let mut boundary = Vec::with_capacity(8);
         for k in 0..3 {
             boundary.push(t[k]);

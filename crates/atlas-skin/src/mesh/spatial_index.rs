@@ -22,7 +22,9 @@ pub struct FaceSpheres {
     pub radii: Vec<f64>,
     /// Largest radius.
     max_radius: f64,
-    grid: CentreGrid,
+    /// Built by the first [`FaceSpheres::faces_near`]: the surfaces asked only for nearest
+    /// points and rays (the guard's, the pieces' bodies) never build it.
+    grid: std::sync::OnceLock<CentreGrid>,
     bvh: FaceBvh,
 }
 
@@ -182,29 +184,36 @@ impl NearestPoint {
 }
 
 impl FaceSpheres {
-    /// Spheres of every face of `mesh` and their grid, in O(F).
+    /// Spheres of every face of `mesh` and their hierarchy, in O(F) (the grid is built
+    /// when first needed). A radius is the square root of the largest squared distance,
+    /// which equals the largest distance (the rounded square root is monotonic).
     pub fn new(mesh: &SurfaceMesh) -> Self {
-        let (centres, radii): (Vec<DVec3>, Vec<f64>) = (0..mesh.triangle_count())
-            .map(|f| {
-                let corners = mesh.corners(f);
-                let centre = (corners[0] + corners[1] + corners[2]) / 3.0;
-                let radius = corners
-                    .iter()
-                    .map(|c| c.distance(centre))
-                    .fold(0.0, f64::max);
-                (centre, radius)
-            })
-            .unzip();
+        let mut centres = Vec::with_capacity(mesh.triangle_count());
+        let mut radii = Vec::with_capacity(mesh.triangle_count());
+        for f in 0..mesh.triangle_count() {
+            let corners = mesh.corners(f);
+            let centre = (corners[0] + corners[1] + corners[2]) / 3.0;
+            let farthest = corners
+                .iter()
+                .map(|c| c.distance_squared(centre))
+                .fold(0.0, f64::max);
+            centres.push(centre);
+            radii.push(farthest.sqrt());
+        }
         let max_radius = radii.iter().copied().fold(0.0, f64::max);
-        let grid = CentreGrid::new(&centres);
         let bvh = FaceBvh::new(mesh, &centres);
         Self {
             centres,
             radii,
             max_radius,
-            grid,
+            grid: std::sync::OnceLock::new(),
             bvh,
         }
+    }
+
+    /// The grid of the face centres, built on first use.
+    fn grid(&self) -> &CentreGrid {
+        self.grid.get_or_init(|| CentreGrid::new(&self.centres))
     }
 
     /// Distance from `p` to the nearest point of the surface, `f64::INFINITY` without faces.
@@ -280,11 +289,11 @@ impl FaceSpheres {
             return Vec::new();
         }
         let reach = DVec3::splat(radius + self.max_radius);
-        let mut faces: Vec<u32> = self
-            .grid
+        let grid = self.grid();
+        let mut faces: Vec<u32> = grid
             .faces_in(
-                self.grid.cell_of(p - reach),
-                self.grid.cell_of(p + reach),
+                grid.cell_of(p - reach),
+                grid.cell_of(p + reach),
                 IVec3::ONE,
                 IVec3::ZERO,
             )

@@ -2,7 +2,6 @@
 
 use super::surface::SurfaceMesh;
 use super::union_find::UnionFind;
-use crate::rows::Rows;
 use crate::tolerance::FLAT;
 
 /// A vertex not yet given a component by [`Topology::vertex_components`].
@@ -28,39 +27,49 @@ pub struct Topology {
 
 impl Topology {
     /// Builds the topology of `mesh` in O(V + F): the half-edges are grouped by their
-    /// smaller vertex with a counting sort ([`Rows::group`], which keeps the stored order
-    /// (f, i) within a group), then each group, a few entries, is sorted stably by its
-    /// larger vertex, which gives the order (a, b, f, i) of edges and of their faces.
+    /// smaller vertex with a counting sort (which keeps the stored order (f, i) within a
+    /// group), then each group, a few entries, is sorted by its larger vertex (keys
+    /// `b · 2³² + 3f + i`, unique, so the order is that of a stable sort by b),
+    /// which gives the order (a, b, f, i) of edges and of their faces.
     pub fn new(mesh: &SurfaceMesh) -> Self {
         let nv = mesh.vertex_count();
         let triangles = &mesh.triangles;
-        let corner = |k: usize| triangles[k / 3][k % 3];
-        let next_corner = |k: usize| triangles[k / 3][(k + 1) % 3];
-        let mut half = Rows::group_indexed(
-            nv,
-            3 * triangles.len(),
-            |k| Some(corner(k).min(next_corner(k)) as usize),
-            |k| {
-                let (a, b) = (corner(k), next_corner(k));
-                (a.max(b), (k / 3) as u32, (k % 3) as u8)
-            },
-        );
+        let half_edges = |t: &[u32; 3]| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])];
+        let mut half_offsets = vec![0u32; nv + 1];
+        for t in triangles {
+            for (a, b) in half_edges(t) {
+                half_offsets[a.min(b) as usize + 1] += 1;
+            }
+        }
+        prefix_sums(&mut half_offsets);
+        let mut next = half_offsets[..nv].to_vec();
+        let mut half = vec![0u64; 3 * triangles.len()];
+        for (f, t) in triangles.iter().enumerate() {
+            for (i, (a, b)) in half_edges(t).into_iter().enumerate() {
+                let slot = &mut next[a.min(b) as usize];
+                half[*slot as usize] = (u64::from(a.max(b)) << 32) | (3 * f + i) as u64;
+                *slot += 1;
+            }
+        }
         let mut edges = Vec::new();
-        let mut face_edges = vec![[0u32; 3]; mesh.triangles.len()];
+        let mut face_edges = vec![[0u32; 3]; triangles.len()];
         let mut edge_face_offsets = vec![0u32];
-        let mut edge_faces = Vec::with_capacity(half.values.len());
+        let mut edge_faces = Vec::with_capacity(half.len());
         for a in 0..nv {
-            let group = &mut half.values[half.offsets[a] as usize..half.offsets[a + 1] as usize];
-            group.sort_by_key(|&(b, _, _)| b);
-            for (k, &(b, f, i)) in group.iter().enumerate() {
-                if k == 0 || group[k - 1].0 != b {
+            let group = &mut half[half_offsets[a] as usize..half_offsets[a + 1] as usize];
+            sort_group(group);
+            let mut previous = None;
+            for &key in group.iter() {
+                let (b, k) = ((key >> 32) as u32, (key & u64::from(u32::MAX)) as usize);
+                if previous != Some(b) {
                     if !edges.is_empty() {
                         edge_face_offsets.push(edge_faces.len() as u32);
                     }
                     edges.push([a as u32, b]);
+                    previous = Some(b);
                 }
-                face_edges[f as usize][i as usize] = edges.len() as u32 - 1;
-                edge_faces.push(f);
+                face_edges[k / 3][k % 3] = edges.len() as u32 - 1;
+                edge_faces.push((k / 3) as u32);
             }
         }
         if !edges.is_empty() {
@@ -69,31 +78,47 @@ impl Topology {
 
         // Both row sets come sorted: a vertex's faces in stored order, its neighbours x < v
         // (edges (x, v)) before those y > v (edges (v, y)), each in edge order.
-        let vertex_faces = Rows::group_indexed(
-            nv,
-            3 * triangles.len(),
-            |k| Some(corner(k) as usize),
-            |k| (k / 3) as u32,
-        );
-        // Entry 2e is edge e seen from its first end, 2e + 1 from its second.
-        let vertex_neighbors = Rows::group_indexed(
-            nv,
-            2 * edges.len(),
-            |k| {
-                let e = edges[k / 2];
-                (e[0] != e[1]).then_some(e[k % 2] as usize)
-            },
-            |k| edges[k / 2][1 - k % 2],
-        );
+        let mut vertex_face_offsets = vec![0u32; nv + 1];
+        for t in triangles {
+            for &v in t {
+                vertex_face_offsets[v as usize + 1] += 1;
+            }
+        }
+        prefix_sums(&mut vertex_face_offsets);
+        next.copy_from_slice(&vertex_face_offsets[..nv]);
+        let mut vertex_faces = vec![0u32; 3 * triangles.len()];
+        for (f, t) in triangles.iter().enumerate() {
+            for &v in t {
+                let slot = &mut next[v as usize];
+                vertex_faces[*slot as usize] = f as u32;
+                *slot += 1;
+            }
+        }
+        // Edge e seen from its first end, then from its second.
+        let mut vertex_neighbor_offsets = vec![0u32; nv + 1];
+        for &[a, b] in edges.iter().filter(|[a, b]| a != b) {
+            vertex_neighbor_offsets[a as usize + 1] += 1;
+            vertex_neighbor_offsets[b as usize + 1] += 1;
+        }
+        prefix_sums(&mut vertex_neighbor_offsets);
+        next.copy_from_slice(&vertex_neighbor_offsets[..nv]);
+        let mut vertex_neighbors = vec![0u32; vertex_neighbor_offsets[nv] as usize];
+        for &[a, b] in edges.iter().filter(|[a, b]| a != b) {
+            for (from, to) in [(a, b), (b, a)] {
+                let slot = &mut next[from as usize];
+                vertex_neighbors[*slot as usize] = to;
+                *slot += 1;
+            }
+        }
         Self {
             edges,
             face_edges,
             edge_face_offsets,
             edge_faces,
-            vertex_face_offsets: vertex_faces.offsets,
-            vertex_faces: vertex_faces.values,
-            vertex_neighbor_offsets: vertex_neighbors.offsets,
-            vertex_neighbors: vertex_neighbors.values,
+            vertex_face_offsets,
+            vertex_faces,
+            vertex_neighbor_offsets,
+            vertex_neighbors,
         }
     }
 
@@ -146,6 +171,32 @@ impl Topology {
             count += 1;
         }
         (label, count as usize)
+    }
+}
+
+/// Turns counts `c[1..]` (with `c[0] = 0`) into offsets: `c[i]` becomes the sum of the
+/// counts before row i.
+fn prefix_sums(counts: &mut [u32]) {
+    for i in 1..counts.len() {
+        counts[i] += counts[i - 1];
+    }
+}
+
+/// Sorts the half-edges around one vertex: a few entries by insertion (where the library
+/// sort's set-up costs more than the sort), a long group (a fan's centre) by the library.
+fn sort_group(keys: &mut [u64]) {
+    if keys.len() > 16 {
+        keys.sort_unstable();
+        return;
+    }
+    for i in 1..keys.len() {
+        let key = keys[i];
+        let mut j = i;
+        while j > 0 && keys[j - 1] > key {
+            keys[j] = keys[j - 1];
+            j -= 1;
+        }
+        keys[j] = key;
     }
 }
 
