@@ -12,7 +12,8 @@ use crate::skeleton::bones::bone_segments;
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
 use rayon::prelude::*;
-use std::collections::{HashSet, VecDeque};
+use rustc_hash::FxHashSet;
+use std::collections::VecDeque;
 
 /// A soft boundary, ready for step 3.
 pub struct SoftSide {
@@ -100,8 +101,9 @@ fn child_side(
     let positions = &d.surface.positions;
     let signed = |v: usize| b.normal.dot(positions[v] - b.point);
     // Every vertex is examined once: κ depends on the vertex alone. (A set, not one bit
-    // per vertex of the surface: thousands of soft boundaries each reach a few vertices.)
-    let mut examined = HashSet::new();
+    // per vertex of the surface: thousands of soft boundaries each reach a few vertices;
+    // hashed by Fx: the keys are vertex indices, not input an attacker chooses.)
+    let mut examined = FxHashSet::default();
     let mut reached = Vec::new();
     let mut queue = VecDeque::new();
     let mut visit = |v: u32, queue: &mut VecDeque<u32>| {
