@@ -24,6 +24,8 @@ fn robotexpressive_hands_follow_the_forearm_and_the_palm_joints_bend_them() {
             let name = format!("{palm}{side}");
             let joint = joints.iter().find(|j| j["name"] == name.as_str()).unwrap();
             assert_eq!(joint["status"], "soft", "{joint}");
+            let reason = joint["reason"].as_str().unwrap();
+            assert!(reason.contains("acts in the region around it"), "{reason}");
             let region = &regions[joint["region"].as_u64().unwrap() as usize];
             assert_eq!(
                 region["joint"],

@@ -223,7 +223,7 @@ fn decide_joints(
                 ),
                 Outcome::Soft { reason, frame } => match region {
                     Some(r) => (
-                        JointStatus::Soft(reason),
+                        JointStatus::Soft(held_elsewhere(skeleton, joint_region, j, reason)),
                         BoundaryKind::Soft,
                         frame,
                         searches[j].candidates.first(),
@@ -257,6 +257,23 @@ fn decide_joints(
         })
         .collect();
     (boundaries, joints)
+}
+
+/// The reason of soft joint `j`, with what [`HoldingRegions`] did when it moved the joint
+/// out of its parent's region.
+fn held_elsewhere(
+    skeleton: &Skeleton,
+    joint_region: &[Option<u32>],
+    j: usize,
+    reason: String,
+) -> String {
+    match skeleton.parent(j).map(|p| joint_region[p]) {
+        Some(Some(parent_region)) if joint_region[j] != Some(parent_region) => format!(
+            "{reason}; its parent's region {parent_region} does not reach its section: it \
+             acts in the region around it, on another piece"
+        ),
+        _ => reason,
+    }
 }
 
 /// A joint's boundary once the surface is split.
