@@ -102,10 +102,11 @@ pub fn decompose(
         .iter()
         .map(|plan| !matches!(plan, JointPlan::Exclude(_)))
         .collect();
-    // The faces of the split surface are indexed only when some joint is soft.
-    let holders = outcomes
-        .iter()
-        .any(|o| matches!(o, Outcome::Soft { .. }))
+    // On one connected surface a joint without a cut lies in its parent's region (§3.2);
+    // the faces of the split surface are indexed only for a surface of several pieces
+    // with a soft joint.
+    let holders = (outcomes.iter().any(|o| matches!(o, Outcome::Soft { .. }))
+        && topology.vertex_components(mesh).1 > 1)
         .then(|| HoldingRegions::new(&surface, &face_region));
     let holding = |j: usize, parent_region: Option<u32>| match (&outcomes[j], &holders) {
         (Outcome::Soft { frame, .. }, Some(holders)) => {
