@@ -361,6 +361,31 @@ impl<'a> Span<'a> {
         })
     }
 
+    /// Runs of consecutive blocks that use the same number of influences (at most `k`):
+    /// each range of vertices with that number. Grouped by influence count
+    /// ([`crate::VertexOrder::by_influence_count`]), a window's blocks form a few runs.
+    pub(crate) fn runs(
+        &self,
+        k: usize,
+    ) -> impl Iterator<Item = (std::ops::Range<usize>, usize)> + use<'a> {
+        let count = self.len();
+        let blocks: &'a [u32] = self.block_influences;
+        let used = move |b: usize| (blocks[b] as usize).min(k);
+        let mut start = 0;
+        std::iter::from_fn(move || {
+            if start == blocks.len() {
+                return None;
+            }
+            let influences = used(start);
+            let end = (start + 1..blocks.len())
+                .find(|&b| used(b) != influences)
+                .unwrap_or(blocks.len());
+            let vertices = start * INFLUENCE_BLOCK..(end * INFLUENCE_BLOCK).min(count);
+            start = end;
+            Some((vertices, influences))
+        })
+    }
+
     /// The first `mid` vertices (a multiple of [`INFLUENCE_BLOCK`]) and the rest (`k`
     /// influences per vertex).
     fn split_at(self, mid: usize, k: usize) -> (Span<'a>, Span<'a>) {
