@@ -486,18 +486,25 @@ unsafe fn linear_blend_span<const K: usize, const NORMALS: bool, const TANGENTS:
     mut span: Span,
 ) {
     let k = if K == 0 { k } else { K };
-    for (vertices, used) in span.blocks(k) {
-        if span.prefetch {
-            prefetch_ahead(&span, vertices.start, k);
-        }
-        let block: BlockLoop = match used {
+    let block_loop = |used: usize| -> BlockLoop {
+        match used {
             1 => linear_blend_block::<1, NORMALS, TANGENTS>,
             2 => linear_blend_block::<2, NORMALS, TANGENTS>,
             3 => linear_blend_block::<3, NORMALS, TANGENTS>,
             4 => linear_blend_block::<4, NORMALS, TANGENTS>,
             _ => linear_blend_block::<0, NORMALS, TANGENTS>,
-        };
-        block(palette, &mut span, vertices, k, used);
+        }
+    };
+    if span.prefetch {
+        for (vertices, used) in span.blocks(k) {
+            prefetch_ahead(&span, vertices.start, k);
+            block_loop(used)(palette, &mut span, vertices, k, used);
+        }
+    } else {
+        // In cache: one call per run of blocks alike, not per block.
+        for (vertices, used) in span.runs(k) {
+            block_loop(used)(palette, &mut span, vertices, k, used);
+        }
     }
 }
 
@@ -584,27 +591,24 @@ unsafe fn dual_quaternion_span<const K: usize, const NORMALS: bool, const TANGEN
     };
     let rows = (joints, weights);
     let unsigned = span.hemispheres_agree;
-    for (start, (_, used)) in (0..batched).step_by(LANES).zip(span.blocks(k)) {
-        let blend: BatchBlend = match (used, unsigned) {
-            (1, _) => blend_batch::<1, true>,
-            (2, false) => blend_batch::<2, false>,
-            (3, false) => blend_batch::<3, false>,
-            (4, false) => blend_batch::<4, false>,
-            (_, false) => blend_batch::<0, false>,
-            (2, true) => blend_batch::<2, true>,
-            (3, true) => blend_batch::<3, true>,
-            (4, true) => blend_batch::<4, true>,
-            (_, true) => blend_batch::<0, true>,
-        };
-        let batch = blend(palette, rows, start, k, used);
-        let positions = span.rest_positions.as_ptr().add(start);
-        let moved = batch.point(load_vec3_batch(positions));
-        store_vec3_batch(span.out_positions.as_mut_ptr().add(start), moved);
-        if NORMALS {
-            let normals = span.rest_normals.as_ptr().add(start);
-            let moved = batch.vector(load_vec3_batch(normals));
-            store_vec3_batch(span.out_normals.as_mut_ptr().add(start), moved);
+    // One call per run of blocks alike (`Span::runs`), not per batch.
+    for (vertices, used) in span.runs(k) {
+        let batches = vertices.start..vertices.end.min(batched);
+        if batches.is_empty() {
+            continue;
         }
+        let run: BatchRun = match (used, unsigned) {
+            (1, _) => dual_quaternion_run::<1, true, NORMALS>,
+            (2, false) => dual_quaternion_run::<2, false, NORMALS>,
+            (3, false) => dual_quaternion_run::<3, false, NORMALS>,
+            (4, false) => dual_quaternion_run::<4, false, NORMALS>,
+            (_, false) => dual_quaternion_run::<0, false, NORMALS>,
+            (2, true) => dual_quaternion_run::<2, true, NORMALS>,
+            (3, true) => dual_quaternion_run::<3, true, NORMALS>,
+            (4, true) => dual_quaternion_run::<4, true, NORMALS>,
+            (_, true) => dual_quaternion_run::<0, true, NORMALS>,
+        };
+        run(palette, rows, &mut span, batches, (k, used));
     }
     for v in batched..span.len() {
         let blend = BlendedDualQuaternion::new(blend_vertex(palette, rows, v, k, k));
@@ -618,9 +622,37 @@ unsafe fn dual_quaternion_span<const K: usize, const NORMALS: bool, const TANGEN
     }
 }
 
-/// A [`blend_batch`]: palette, rows, first vertex, K, influences used.
-type BatchBlend =
-    unsafe fn(*const f32, (*const u16, *const f32), usize, usize, usize) -> DualQuaternionBatch;
+/// A [`dual_quaternion_run`]: palette, rows, span, vertices, (K, influences used).
+type BatchRun =
+    unsafe fn(*const f32, (*const u16, *const f32), &mut Span, Range<usize>, (usize, usize));
+
+/// The batches of eight vertices in `vertices` (whole batches), blended over their first
+/// `USED` influences (or `used` when `USED` is 0) by [`blend_batch`], positions and
+/// optional normals moved and stored.
+///
+/// # Safety
+/// As [`blend_batch`] for each batch; `vertices` within the span, a multiple of
+/// [`LANES`] long and starting at a multiple of it.
+#[target_feature(enable = "avx2,fma")]
+unsafe fn dual_quaternion_run<const USED: usize, const UNSIGNED: bool, const NORMALS: bool>(
+    palette: *const f32,
+    rows: (*const u16, *const f32),
+    span: &mut Span,
+    vertices: Range<usize>,
+    (k, used): (usize, usize),
+) {
+    for start in vertices.step_by(LANES) {
+        let batch = blend_batch::<USED, UNSIGNED>(palette, rows, start, k, used);
+        let positions = span.rest_positions.as_ptr().add(start);
+        let moved = batch.point(load_vec3_batch(positions));
+        store_vec3_batch(span.out_positions.as_mut_ptr().add(start), moved);
+        if NORMALS {
+            let normals = span.rest_normals.as_ptr().add(start);
+            let moved = batch.vector(load_vec3_batch(normals));
+            store_vec3_batch(span.out_normals.as_mut_ptr().add(start), moved);
+        }
+    }
+}
 
 /// The eight vertices from `start` blended over their first `USED` influences (or `used`
 /// when `USED` is 0); `UNSIGNED`: without the sign fix

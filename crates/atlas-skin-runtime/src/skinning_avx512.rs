@@ -97,18 +97,25 @@ unsafe fn linear_blend_span<const K: usize, const NORMALS: bool>(
     mut span: Span,
 ) {
     let k = if K == 0 { k } else { K };
-    for (vertices, used) in span.blocks(k) {
-        if span.prefetch {
-            prefetch_ahead(&span, vertices.start, k);
-        }
-        let block: InfluenceBlockLoop = match used {
+    let block_loop = |used: usize| -> InfluenceBlockLoop {
+        match used {
             1 => linear_blend_block::<1, NORMALS>,
             2 => linear_blend_block::<2, NORMALS>,
             3 => linear_blend_block::<3, NORMALS>,
             4 => linear_blend_block::<4, NORMALS>,
             _ => linear_blend_block::<0, NORMALS>,
-        };
-        block(palette, &mut span, vertices, (k, used));
+        }
+    };
+    if span.prefetch {
+        for (vertices, used) in span.blocks(k) {
+            prefetch_ahead(&span, vertices.start, k);
+            block_loop(used)(palette, &mut span, vertices, (k, used));
+        }
+    } else {
+        // In cache: one call per run of blocks alike, not per block.
+        for (vertices, used) in span.runs(k) {
+            block_loop(used)(palette, &mut span, vertices, (k, used));
+        }
     }
 }
 

@@ -10,9 +10,16 @@ use crate::skinning_palette::{SkinningMethod, SkinningPalette};
 use crate::RuntimeError;
 use glam::{Mat4, Quat, Vec3, Vec4};
 
-/// Vertices per task when running on the rayon pool: large enough to amortise a task,
-/// small enough (≈ 200 KB of streams) to balance two to a few dozen threads.
-pub const PARALLEL_CHUNK: usize = 4096;
+/// Vertices per task when running on the rayon pool: large enough to amortise a task (a
+/// few microseconds of skinning), small enough that a character of a few thousand
+/// vertices gives each of two threads work (cesiumman's 3,273 vertices are two tasks)
+/// and that a thread that cannot run leaves little for the others to wait for. Measured
+/// against 4,096 on 2 threads (`atlas-skin bench`, 5 interleaved rounds): at load 2.7
+/// cesiumman 1.34× (4,096 ran it on one thread), the demo and makehuman 1.03× and 1.02×;
+/// at load 5.5, when the process had about two thirds of a core, the demo and cesiumman
+/// level (1.01×), makehuman too spread to tell (interquartile range of its ratio to ozz
+/// 0.90–1.42 against 1.27–1.40).
+pub const PARALLEL_CHUNK: usize = 2048;
 const _: () = assert!(
     PARALLEL_CHUNK.is_multiple_of(INFLUENCE_BLOCK),
     "spans split at block boundaries"
@@ -351,6 +358,31 @@ impl<'a> Span<'a> {
                 start..(start + INFLUENCE_BLOCK).min(count),
                 (used as usize).min(k),
             )
+        })
+    }
+
+    /// Runs of consecutive blocks that use the same number of influences (at most `k`):
+    /// each range of vertices with that number. Grouped by influence count
+    /// ([`crate::VertexOrder::by_influence_count`]), a window's blocks form a few runs.
+    pub(crate) fn runs(
+        &self,
+        k: usize,
+    ) -> impl Iterator<Item = (std::ops::Range<usize>, usize)> + use<'a> {
+        let count = self.len();
+        let blocks: &'a [u32] = self.block_influences;
+        let used = move |b: usize| (blocks[b] as usize).min(k);
+        let mut start = 0;
+        std::iter::from_fn(move || {
+            if start == blocks.len() {
+                return None;
+            }
+            let influences = used(start);
+            let end = (start + 1..blocks.len())
+                .find(|&b| used(b) != influences)
+                .unwrap_or(blocks.len());
+            let vertices = start * INFLUENCE_BLOCK..(end * INFLUENCE_BLOCK).min(count);
+            start = end;
+            Some((vertices, influences))
         })
     }
 

@@ -1,8 +1,11 @@
 //! A frame allocates nothing: preparing the palette (with its hemispheres aligned) and
 //! skinning positions and normals (of a small mesh and of one whose loops prefetch), by
 //! linear blend and by dual quaternions, with every instruction set this CPU runs, on one
-//! thread. This test binary alone replaces the global allocator by one that counts (the
-//! library and the `atlas-skin` binary use the system's unchanged).
+//! thread and on a rayon pool of two. This test binary
+//! alone replaces the global allocator by one that counts (the library and the
+//! `atlas-skin` binary use the system's unchanged); it has no test harness
+//! (`harness = false`), so that the only threads that run while it counts are its own
+//! and the workers of the job.
 
 use atlas_skin_runtime::random_pose::{random_rotations, SplitMix64};
 use atlas_skin_runtime::{
@@ -11,25 +14,15 @@ use atlas_skin_runtime::{
 };
 use glam::{Mat4, Vec3};
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-/// The system allocator, counting the allocations of the threads that ask for it.
+/// The system allocator, counting the allocations of every thread.
 struct CountingAllocator;
 
 static ALLOCATIONS: AtomicU64 = AtomicU64::new(0);
 
-thread_local! {
-    /// Whether this thread's allocations count: only the test's own thread, which runs the
-    /// frames (`Threading::Sequential`), so that the test harness's other threads do not
-    /// (under load its main thread allocated while the frames ran).
-    static COUNTING: Cell<bool> = const { Cell::new(false) };
-}
-
 fn count() {
-    if COUNTING.try_with(Cell::get).unwrap_or(false) {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-    }
+    ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
 }
 
 // SAFETY: forwards every call unchanged to `System`, which upholds the contract.
@@ -57,15 +50,21 @@ unsafe impl GlobalAlloc for CountingAllocator {
 #[global_allocator]
 static GLOBAL: CountingAllocator = CountingAllocator;
 
-/// A small mesh, and one large enough for the loops that prefetch.
-#[test]
-fn a_frame_allocates_nothing() {
-    frames_allocate_nothing(5_000);
-    frames_allocate_nothing(atlas_skin_runtime::skinning_job::PREFETCH_FROM + 8);
+/// A small mesh, and one large enough for the loops that prefetch, on one thread and on
+/// two.
+fn main() {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .expect("thread pool");
+    for vertices in [5_000, atlas_skin_runtime::skinning_job::PREFETCH_FROM + 8] {
+        frames_allocate_nothing(vertices, Threading::Sequential);
+        pool.install(|| frames_allocate_nothing(vertices, Threading::Parallel));
+    }
+    println!("a frame allocates nothing: ok");
 }
 
-fn frames_allocate_nothing(vertices: usize) {
-    COUNTING.with(|counting| counting.set(true));
+fn frames_allocate_nothing(vertices: usize, threading: Threading) {
     const JOINTS: usize = 16;
     let mut rng = SplitMix64::new(3);
     let rest: Vec<Vec3> = (0..vertices).map(|_| rng.unit_vector()).collect();
@@ -95,7 +94,7 @@ fn frames_allocate_nothing(vertices: usize) {
                 SkinningJob {
                     skin: &skin,
                     palette: &palette,
-                    threading: Threading::Sequential,
+                    threading,
                     rest_positions: &rest,
                     rest_normals: Some(&normals),
                     rest_tangents: None,
@@ -113,7 +112,12 @@ fn frames_allocate_nothing(vertices: usize) {
                 frame(pose);
             }
             let allocations = ALLOCATIONS.load(Ordering::Relaxed) - before;
-            assert_eq!(allocations, 0, "{vertices}: {} {method:?}", set.name());
+            assert_eq!(
+                allocations,
+                0,
+                "{vertices}: {} {method:?} {threading:?}",
+                set.name()
+            );
         }
     }
 }

@@ -329,7 +329,8 @@ fn invalid_jobs_are_rejected() {
     }
 }
 
-/// Enough vertices for several parallel chunks: the split must not change any result.
+/// Enough vertices for several parallel parts, every weight format, with and without
+/// tangents, on rayon pools of 2 and 3 threads: the split must not change any result.
 #[test]
 fn parallel_run_equals_sequential_run_bit_for_bit() {
     let count = 3 * atlas_skin_runtime::skinning_job::PARALLEL_CHUNK + 17;
@@ -337,39 +338,52 @@ fn parallel_run_equals_sequential_run_bit_for_bit() {
         .map(|i| Vec3::new(i as f32, (i % 13) as f32, 1.0))
         .collect();
     let normals = vec![Vec3::Z; count];
-    let weights =
-        VertexWeights::from_rows((0..count as u32).map(|i| vec![(i % 3, 1.0), ((i + 1) % 3, 0.5)]));
-    let skin = CompactSkin::new(&weights, 3, 4).unwrap();
+    let weights = VertexWeights::from_rows(
+        (0..count as u32).map(|i| vec![(i % 3, 1.0), ((i + 1) % 3, 0.5), (2, (i % 5) as f32)]),
+    );
     let matrices = [
         rigid([0.1, 0.2, 0.3, 0.9], [1.0, 0.0, 0.0]),
         Mat4::IDENTITY,
         rigid([0.5, 0.0, 0.0, 0.5], [0.0, 2.0, 0.0]),
     ];
-    for method in [SkinningMethod::LinearBlend, SkinningMethod::DualQuaternion] {
-        let sequential = run_job(
-            InstructionSet::best(),
-            &skin,
-            &matrices,
-            method,
-            Threading::Sequential,
-            &rest,
-            &normals,
-            false,
-        )
-        .unwrap();
-        let parallel = run_job(
-            InstructionSet::best(),
-            &skin,
-            &matrices,
-            method,
-            Threading::Parallel,
-            &rest,
-            &normals,
-            false,
-        )
-        .unwrap();
-        assert_eq!(sequential.positions, parallel.positions);
-        assert_eq!(sequential.normals, parallel.normals);
+    let pools = [2, 3].map(|threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+    });
+    for format in [
+        WeightFormat::Float32,
+        WeightFormat::Unorm16,
+        WeightFormat::Unorm8,
+    ] {
+        let skin = CompactSkin::with_format(&weights, 3, 4, format).unwrap();
+        for (method, tangents) in [SkinningMethod::LinearBlend, SkinningMethod::DualQuaternion]
+            .into_iter()
+            .flat_map(|m| [(m, false), (m, true)])
+        {
+            let run = |threading| {
+                run_job(
+                    InstructionSet::best(),
+                    &skin,
+                    &matrices,
+                    method,
+                    threading,
+                    &rest,
+                    &normals,
+                    tangents,
+                )
+                .unwrap()
+            };
+            let sequential = run(Threading::Sequential);
+            for (threads, pool) in [2, 3].into_iter().zip(&pools) {
+                let parallel = pool.install(|| run(Threading::Parallel));
+                let what = format!("{format:?} {method:?} tangents {tangents} {threads} threads");
+                assert_eq!(sequential.positions, parallel.positions, "{what}");
+                assert_eq!(sequential.normals, parallel.normals, "{what}");
+                assert_eq!(sequential.tangents, parallel.tangents, "{what}");
+            }
+        }
     }
 }
 
