@@ -268,19 +268,26 @@ mod tests {
         }
     }
 
+    /// Five joints named `names`: the first the root, the next three a chain below it,
+    /// the last a second child of the root, at `positions`.
+    fn two_branches(names: [&str; 5], positions: &[Vec3; 5]) -> Skeleton {
+        Skeleton::from_positions(
+            names.map(String::from).to_vec(),
+            vec![NO_PARENT, 0, 1, 2, 0],
+            positions,
+        )
+        .expect("a valid skeleton")
+    }
+
     #[test]
     fn a_region_holding_a_joint_its_parents_region_does_not_reach_is_bound_like_that_region() {
         // root (0) → forearm (1, cut: region 1) → palm (2, soft) → finger (3, soft), and
         // root → head (4, soft). Region 0 is the root's, region 2 a separate hand piece
         // around the palm, region 3 a piece around nothing.
-        let skeleton = Skeleton::from_positions(
-            ["root", "forearm", "palm", "finger", "head"]
-                .map(String::from)
-                .to_vec(),
-            vec![NO_PARENT, 0, 1, 2, 0],
+        let skeleton = two_branches(
+            ["root", "forearm", "palm", "finger", "head"],
             &[Vec3::ZERO, Vec3::X, 2.0 * Vec3::X, 3.0 * Vec3::X, Vec3::Y],
-        )
-        .expect("a valid skeleton");
+        );
         let mesh = SurfaceMesh {
             positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y],
             triangles: vec![[0, 1, 2]; 4],
@@ -322,14 +329,10 @@ mod tests {
         // Region 0 lies on the parent side of the arm's cut and of the leg's cut, region 1
         // is the arm's, region 2 the hand's, region 3 the leg's; region 4 lies on the parent
         // side of nothing.
-        let skeleton = Skeleton::from_positions(
-            ["root", "spine", "arm", "hand", "leg"]
-                .map(String::from)
-                .to_vec(),
-            vec![NO_PARENT, 0, 1, 2, 0],
+        let skeleton = two_branches(
+            ["root", "spine", "arm", "hand", "leg"],
             &[Vec3::ZERO, Vec3::Y, Vec3::X, 2.0 * Vec3::X, -Vec3::Y],
-        )
-        .expect("a valid skeleton");
+        );
         let cut_parent = [None, None, Some(0), Some(1), Some(0)];
         let fresh = || {
             vec![
