@@ -271,7 +271,8 @@ fn held_elsewhere(
     match skeleton.parent(j).map(|p| joint_region[p]) {
         Some(Some(parent_region)) if joint_region[j] != Some(parent_region) => format!(
             "{reason}; its parent's region {parent_region} does not reach its section: it \
-             acts in the region around it, on another piece"
+             acts in the region around it, {}",
+            joint_region[j].map_or("none".to_string(), |r| r.to_string())
         ),
         _ => reason,
     }
