@@ -19,6 +19,7 @@ use crate::cuts::split::split_along_curves;
 use crate::decomposition::{Boundary, BoundaryKind, Decomposition, JointDecision, JointStatus};
 use crate::mesh::{FaceSpheres, SurfaceMesh, Topology};
 use crate::regions::holding::HoldingRegions;
+use crate::regions::shared_sides::{divide_shared_sides, ChildSide};
 use crate::regions::{bind_parent_sides, bind_regions, grow_regions, side_regions};
 use crate::skeleton::bones::{joint_pairs, BoneIndex};
 use atlas_skin_runtime::Skeleton;
@@ -76,16 +77,36 @@ pub fn decompose(
     let split = split_along_curves(mesh, topology, &curves);
     let surface = split.mesh;
     let split_topology = Topology::new(&surface);
-    let (face_region, region_count) = grow_regions(&surface, &split_topology, &split.loops);
+    let (mut face_region, mut region_count) = grow_regions(&surface, &split_topology, &split.loops);
 
-    let outcomes = settle_cuts(
-        placements,
-        &searches,
+    let sides_from = |outcomes: &mut [Outcome], face_region: &[u32]| {
+        assign_sides(outcomes, &searches, &surface, &split_topology, face_region);
+    };
+    let mut outcomes = settle_cuts(placements, split.loops);
+    sides_from(&mut outcomes, &face_region);
+    let child_sides: Vec<ChildSide> = outcomes
+        .iter()
+        .enumerate()
+        .filter_map(|(j, o)| match o {
+            Outcome::Cut { child, curve, .. } => Some(ChildSide {
+                joint: j as u32,
+                region: *child,
+                curve,
+            }),
+            _ => None,
+        })
+        .collect();
+    let shared_sides = divide_shared_sides(
         &surface,
         &split_topology,
-        &face_region,
-        split.loops,
+        skeleton,
+        &mut face_region,
+        &mut region_count,
+        &child_sides,
     );
+    if !shared_sides.is_empty() {
+        sides_from(&mut outcomes, &face_region);
+    }
     let sides = |want_child: bool| -> Vec<Option<u32>> {
         outcomes
             .iter()
@@ -140,48 +161,66 @@ pub fn decompose(
         regions,
         boundaries,
         joints,
+        shared_sides,
     })
 }
 
 /// The outcome of every joint once the surface is split along the placed cuts: each cut
-/// takes its loop (`loops` holds one per placed cut, in placement order) and the regions
-/// on its two sides; a cut that does not separate the surface becomes a soft boundary.
-fn settle_cuts(
-    placements: Vec<Placement>,
-    searches: &[CutSearch],
-    surface: &SurfaceMesh,
-    topology: &Topology,
-    face_region: &[u32],
-    loops: Vec<Vec<u32>>,
-) -> Vec<Outcome> {
+/// takes its loop (`loops` holds one per placed cut, in placement order); its sides are
+/// set by [`assign_sides`].
+fn settle_cuts(placements: Vec<Placement>, loops: Vec<Vec<u32>>) -> Vec<Outcome> {
     let mut loops = loops.into_iter();
     placements
         .into_iter()
-        .enumerate()
-        .map(|(j, placement)| match placement {
+        .map(|placement| match placement {
             Placement::Cut { candidate, frame } => {
                 let curve = loops.next();
                 debug_assert!(curve.is_some(), "one split loop per placed cut");
-                let curve = curve.unwrap_or_default();
-                let plane = &searches[j].candidates[candidate].plane;
-                match side_regions(surface, topology, face_region, &curve, plane) {
-                    Some((parent, child)) if parent != child => Outcome::Cut {
-                        candidate,
-                        curve,
-                        parent,
-                        child,
-                        frame,
-                    },
-                    _ => Outcome::Soft {
-                        reason: "its closed cut does not separate the surface".into(),
-                        frame,
-                    },
+                Outcome::Cut {
+                    candidate,
+                    curve: curve.unwrap_or_default(),
+                    parent: 0,
+                    child: 0,
+                    frame,
                 }
             }
             Placement::Soft { reason, frame } => Outcome::Soft { reason, frame },
             Placement::Skip(reason) => Outcome::Skip(reason),
         })
         .collect()
+}
+
+/// Sets the regions on the two sides of every cut from `face_region`; a cut that does not
+/// separate the surface becomes a soft boundary.
+fn assign_sides(
+    outcomes: &mut [Outcome],
+    searches: &[CutSearch],
+    surface: &SurfaceMesh,
+    topology: &Topology,
+    face_region: &[u32],
+) {
+    for (j, outcome) in outcomes.iter_mut().enumerate() {
+        let Outcome::Cut {
+            candidate,
+            curve,
+            parent,
+            child,
+            frame,
+        } = outcome
+        else {
+            continue;
+        };
+        let plane = &searches[j].candidates[*candidate].plane;
+        match side_regions(surface, topology, face_region, curve, plane) {
+            Some((p, c)) if p != c => (*parent, *child) = (p, c),
+            _ => {
+                *outcome = Outcome::Soft {
+                    reason: "its closed cut does not separate the surface".into(),
+                    frame: *frame,
+                }
+            }
+        }
+    }
 }
 
 /// The boundaries and the per-joint decisions, in skeleton order. A cut's plane,

@@ -2,6 +2,7 @@
 //! (§3.3–§5) reads. Plain data; [`crate::decompose()`] builds it.
 
 use crate::mesh::{SurfaceMesh, Topology};
+use crate::regions::shared_sides::SharedSide;
 use glam::DVec3;
 use serde::Serialize;
 
@@ -22,6 +23,9 @@ pub struct Decomposition {
     pub boundaries: Vec<Boundary>,
     /// One decision per skeleton joint, in skeleton order.
     pub joints: Vec<JointDecision>,
+    /// Regions that were the child side of the cuts of unrelated joints (a hand fused to
+    /// the hip) and were divided among them ([`crate::regions::shared_sides`]).
+    pub shared_sides: Vec<SharedSide>,
 }
 
 /// A connected part of the split surface.

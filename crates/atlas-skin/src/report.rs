@@ -12,6 +12,17 @@ pub struct DecompositionReport {
     pub skipped: usize,
     pub joints: Vec<JointReport>,
     pub regions: Vec<RegionReport>,
+    /// Regions the child sides of unrelated joints' cuts shared, divided among them.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub shared_sides: Vec<SharedSideReport>,
+}
+
+/// A divided region: the head joint of each family of cuts that shared it and the region
+/// each family's part became.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SharedSideReport {
+    pub joints: Vec<String>,
+    pub regions: Vec<u32>,
 }
 
 /// One joint: its status (`cut`, `soft` or `skipped`), the reason when not cut, and its
@@ -95,6 +106,14 @@ impl Decomposition {
             skipped: count(|s| matches!(s, JointStatus::Skipped(_))),
             joints,
             regions,
+            shared_sides: self
+                .shared_sides
+                .iter()
+                .map(|shared| SharedSideReport {
+                    joints: shared.joints.iter().map(name).collect(),
+                    regions: shared.regions.clone(),
+                })
+                .collect(),
         }
     }
 }

@@ -171,6 +171,7 @@ fn decompose_by_hand(
         regions,
         boundaries,
         joints,
+        shared_sides: Vec::new(),
     }
 }
 

@@ -399,7 +399,7 @@ fn is_inside_by_rays(
 
 /// +1 for an outward-oriented closed surface, −1 for an inward one, 0 when the signed
 /// volume Σ a · (b × c) / 6 is negligible (open strips): ray hits are then not filtered.
-fn orientation_sign(mesh: &SurfaceMesh) -> f64 {
+pub(crate) fn orientation_sign(mesh: &SurfaceMesh) -> f64 {
     let volume = mesh.signed_volume();
     if volume.abs() <= NEGLIGIBLE * mesh.diagonal().powi(3) {
         0.0

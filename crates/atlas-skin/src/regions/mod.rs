@@ -20,6 +20,7 @@
 //! region of every joint and the joints each region holds ([`Region`]).
 
 pub mod holding;
+pub mod shared_sides;
 
 use crate::cuts::plane_section::Plane;
 use crate::decomposition::Region;

@@ -140,6 +140,19 @@ pub fn decomposition_warnings(decomposition: &Decomposition, forbidden: &[String
             listed(outside.into_iter())
         ));
     }
+    for shared in &decomposition.shared_sides {
+        warnings.push(format!(
+            "the surface joins the sides of the cuts of {} (a higher genus: a hand fused to \
+             the body, a part welded across a joint): their region was divided among them by \
+             the bones behind each face",
+            listed(
+                shared
+                    .joints
+                    .iter()
+                    .map(|&j| joints[j as usize].name.clone())
+            )
+        ));
+    }
     if joints.len() >= 2 && decomposition.boundaries.is_empty() {
         warnings.push(format!(
             "no joint got a boundary: the whole mesh is {} region(s) bound rigidly to their \
