@@ -7,10 +7,6 @@
 
 mod support;
 
-use serde_json::Value;
-use std::ffi::OsString;
-use support::atlas_skin_ok;
-
 #[test]
 fn robotexpressive_hands_follow_the_forearm_and_the_palm_joints_bend_them() {
     let input = atlas_skin_corpus::data_dir().join("bench/robotexpressive/RobotExpressive.glb");
@@ -39,16 +35,7 @@ fn robotexpressive_hands_follow_the_forearm_and_the_palm_joints_bend_them() {
             );
         }
     }
-    let eval = atlas_skin_ok(&[
-        OsString::from("eval"),
-        input.into(),
-        glb.into(),
-        "--anim-frames".into(),
-        "0".into(),
-        "--json".into(),
-    ]);
-    let figures: Value = serde_json::from_slice(&eval.stdout).unwrap();
-    let deform = &figures["deform_random"];
+    let deform = support::deform_random(&input, &glb);
     // Measured 0.0003 / 0.031; the hands bound to a finger gave 0.0021 / 0.187.
     assert!(deform["mean"].as_f64().unwrap() < 0.001, "{deform}");
     assert!(deform["max"].as_f64().unwrap() < 0.08, "{deform}");

@@ -48,6 +48,24 @@ pub fn skin_with_report(input: &Path, dir: &Path, stem: &str) -> (PathBuf, serde
     (glb, report)
 }
 
+/// `atlas-skin eval REFERENCE CANDIDATE --anim-frames 0 --json`: the candidate's
+/// deformation against the reference's weights over `eval`'s random poses
+/// (`deform_random`: mean and max over the bounding-box diagonal).
+pub fn deform_random(reference: &Path, candidate: &Path) -> serde_json::Value {
+    let args: [&OsStr; 6] = [
+        "eval".as_ref(),
+        reference.as_ref(),
+        candidate.as_ref(),
+        "--anim-frames".as_ref(),
+        "0".as_ref(),
+        "--json".as_ref(),
+    ];
+    let eval = atlas_skin_ok(&args);
+    let figures: serde_json::Value =
+        serde_json::from_slice(&eval.stdout).expect("eval --json prints JSON");
+    figures["deform_random"].clone()
+}
+
 /// A fresh, empty output folder for one test under the target's test temp dir.
 pub fn out_dir(test: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))

@@ -45,10 +45,13 @@ impl SoftSide {
 /// Step 3's child sides: for each soft boundary, a flood along edges from the vertices of
 /// the joint's cross-section (within the band |n·(p − o)| ≤ w and within max(D, w) of the
 /// joint), through vertices related to the boundary's region whose signed plane distance
-/// exceeds −w and where κ > 0 ([`super::ownership`]). A soft boundary with no
-/// cross-section (diameter 0, or no band vertex near the joint where κ > 0: face bones in
-/// a mouth cavity or an eye socket) is inactive: its joint gets no weight and its region's
-/// other joints keep it.
+/// exceeds −w and where κ > 0 ([`super::ownership`]). Where no such vertex lies within
+/// max(D, w) of a joint that has child bones (a coarse mesh whose faces are larger than
+/// the section: KayKit's hips), the seeds are those within d_N + max(D, w), d_N the
+/// distance from the joint to the nearest vertex of the surface. A soft boundary with no
+/// cross-section (diameter 0, or no seed: face bones in a mouth cavity or an eye socket,
+/// whose leaf joints are not seeded farther) is inactive: its joint gets no weight and its
+/// region's other joints keep it.
 pub fn soft_sides(
     decomposition: &Decomposition,
     skeleton: &Skeleton,
@@ -71,6 +74,7 @@ pub fn soft_sides(
     // The surface's vertices as points, for the seeds near each joint.
     let points: Vec<[DVec3; 2]> = d.surface.positions.iter().map(|&p| [p, p]).collect();
     let vertices = BoneTree::of_segments(&points);
+    let children = skeleton.children();
     d.boundaries
         .par_iter()
         .enumerate()
@@ -80,15 +84,26 @@ pub fn soft_sides(
             let owner = Ownership::new(&bones, b.joint as usize, b.parent_region, half_width);
             let beyond = owner.beyond(&free, b.joint as usize);
             let in_region = |v: usize| related.row(v).iter().any(|&(r, _)| r == b.parent_region);
-            child_side(d, b, half_width, &owner, &beyond, in_region, &vertices)
+            let seeds = Seeds {
+                vertices: &vertices,
+                beyond_nearest: !children[b.joint as usize].is_empty(),
+            };
+            child_side(d, b, half_width, &owner, &beyond, in_region, &seeds)
         })
         .collect()
 }
 
+/// Where a soft boundary's flood starts: the surface's vertices as points, and whether the
+/// seeds may lie beyond the nearest vertex (a joint with child bones).
+struct Seeds<'a> {
+    vertices: &'a BoneTree,
+    beyond_nearest: bool,
+}
+
 /// The child side of the soft boundary `b` (half-width `half_width`, κ from `owner`, π from
 /// `beyond`): the flood of [`soft_sides`] from the vertices near the joint (found in
-/// `vertices`, the surface's vertices as points), through vertices where `in_region` holds
-/// (those the region reaches); `None` when no seed qualifies (an inactive boundary).
+/// `seeds`), through vertices where `in_region` holds (those the region reaches); `None`
+/// when no seed qualifies (an inactive boundary).
 fn child_side(
     d: &Decomposition,
     b: &Boundary,
@@ -96,7 +111,7 @@ fn child_side(
     owner: &Ownership,
     beyond: &Ownership,
     in_region: impl Fn(usize) -> bool,
-    vertices: &BoneTree,
+    seeds: &Seeds,
 ) -> Option<SoftSide> {
     let positions = &d.surface.positions;
     let signed = |v: usize| b.normal.dot(positions[v] - b.point);
@@ -129,10 +144,16 @@ fn child_side(
     // The seeds: the vertices near the joint (`visit` keeps those of the region; the
     // flood's result does not depend on their order).
     let seed_radius = b.diameter.max(half_width);
-    for v in vertices.within(b.point, seed_radius) {
-        if signed(v as usize) <= half_width {
-            visit(v, &mut queue);
+    let mut seed_within = |radius: f64, queue: &mut VecDeque<u32>| {
+        for v in seeds.vertices.within(b.point, radius) {
+            if signed(v as usize) <= half_width {
+                visit(v, queue);
+            }
         }
+    };
+    seed_within(seed_radius, &mut queue);
+    if queue.is_empty() && seeds.beyond_nearest {
+        seed_within(seeds.vertices.nearest(b.point) + seed_radius, &mut queue);
     }
     if queue.is_empty() {
         return None;
