@@ -20,8 +20,11 @@ use crate::decomposition::{Boundary, BoundaryKind, Decomposition, JointDecision,
 use crate::mesh::{FaceSpheres, SurfaceMesh, Topology};
 use crate::regions::holding::HoldingRegions;
 use crate::regions::shared_sides::{divide_shared_sides, ChildSide};
-use crate::regions::{bind_parent_sides, bind_regions, grow_regions, side_regions};
-use crate::skeleton::bones::{joint_pairs, BoneIndex};
+use crate::regions::{
+    bind_parent_sides, bind_regions, grow_regions, nearest_bone_joints, side_regions,
+};
+use crate::skeleton::bone_tree::BoneTree;
+use crate::skeleton::bones::{bone_segments, joint_pairs, BoneIndex};
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -152,7 +155,16 @@ pub fn decompose(
     for (decision, &owns) in joints.iter_mut().zip(&owns_skin) {
         decision.owns_skin = owns;
     }
-    bind_parent_sides(&mut regions, skeleton, &cut_parent, &owns_skin);
+    // The bones are indexed only when some region without joints lies on a parent side.
+    let bones = std::cell::OnceCell::new();
+    bind_parent_sides(&mut regions, skeleton, &cut_parent, &owns_skin, |r| {
+        let (segments, tree) = bones.get_or_init(|| {
+            let segments = bone_segments(skeleton);
+            let ends: Vec<[DVec3; 2]> = segments.iter().map(|&(_, a, b)| [a, b]).collect();
+            (segments, BoneTree::of_segments(&ends))
+        });
+        nearest_bone_joints(&surface, &face_region, r, tree, segments)
+    });
     Ok(Decomposition {
         topology: split_topology,
         welded_vertex_count: mesh.vertex_count(),

@@ -25,6 +25,9 @@ pub mod shared_sides;
 use crate::cuts::plane_section::Plane;
 use crate::decomposition::Region;
 use crate::mesh::{SurfaceMesh, Topology};
+use crate::skeleton::bone_tree::BoneTree;
+#[cfg(doc)]
+use crate::skeleton::bones::bone_segments;
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
 
@@ -203,17 +206,24 @@ pub fn bind_regions(
 
 /// Binds every region that no joint is bound to but that lies on the parent side of a cut
 /// (a torso whose root joint lies outside it and was bound beside it; the part of a leg
-/// piece above a hip cut whose parent lies in another piece) to the joint that moves that
-/// side: the cut joint's nearest ancestor that owns skin. Of several such cuts, the
-/// ancestor nearest the root wins. Returns how many regions were bound.
+/// piece above a hip cut whose parent lies in another piece; a chin left below the head's
+/// cut). Such a region R on the parent side of the cut of joint k hangs from k when the
+/// bones nearest to more than half of its faces are those of k or of the joints below it
+/// (the chin lies nearer to the head's mouth bone than to the neck): it moves with k.
+/// Otherwise it moves with the joint that moves that side: k's nearest ancestor that owns
+/// skin. Of several such cuts, the joint nearest the root wins. Returns how many regions
+/// were bound.
 ///
 /// - `cut_parent`: #J parent region of every joint with a separating cut.
 /// - `owns_skin`: #J whether the joint may take weight.
+/// - `face_joints(r)`: the joint of the bone nearest to each face of region r
+///   ([`nearest_bone_joints`]).
 pub fn bind_parent_sides(
     regions: &mut [Region],
     skeleton: &Skeleton,
     cut_parent: &[Option<u32>],
     owns_skin: &[bool],
+    face_joints: impl Fn(u32) -> Vec<u32>,
 ) -> usize {
     let order = skeleton.topological_order();
     let mut rank = vec![0usize; skeleton.len()];
@@ -221,12 +231,22 @@ pub fn bind_parent_sides(
         rank[j] = k;
     }
     let mut chosen: Vec<Option<u32>> = vec![None; regions.len()];
+    let mut nearest: Vec<Option<Vec<u32>>> = vec![None; regions.len()];
     for (k, parent_side) in cut_parent.iter().enumerate() {
         let Some(r) = *parent_side else { continue };
         if !regions[r as usize].joints.is_empty() {
             continue;
         }
-        let Some(mover) = skeleton.ancestors(k).find(|&a| owns_skin[a]) else {
+        let faces = nearest[r as usize].get_or_insert_with(|| face_joints(r));
+        let below_k =
+            |j: &&u32| **j as usize == k || skeleton.ancestors(**j as usize).any(|a| a == k);
+        let hangs = owns_skin[k] && 2 * faces.iter().filter(below_k).count() > faces.len();
+        let mover = if hangs {
+            Some(k)
+        } else {
+            skeleton.ancestors(k).find(|&a| owns_skin[a])
+        };
+        let Some(mover) = mover else {
             continue;
         };
         let slot = &mut chosen[r as usize];
@@ -243,6 +263,26 @@ pub fn bind_parent_sides(
         }
     }
     bound
+}
+
+/// The joint of the bone segment ([`bone_segments`]) nearest to the centroid of each face
+/// of region `region`, in face order.
+pub fn nearest_bone_joints(
+    mesh: &SurfaceMesh,
+    face_region: &[u32],
+    region: u32,
+    bones: &BoneTree,
+    segments: &[(u32, DVec3, DVec3)],
+) -> Vec<u32> {
+    (0..mesh.triangle_count())
+        .filter(|&f| face_region[f] == region)
+        .filter_map(|f| {
+            let [a, b, c] = mesh.corners(f);
+            let p = (a + b + c) / 3.0;
+            let nearest = bones.within(p, bones.nearest(p)).into_iter().next()?;
+            Some(segments[nearest as usize].0)
+        })
+        .collect()
 }
 
 fn nearest_face_region(mesh: &SurfaceMesh, face_region: &[u32], p: DVec3) -> Option<u32> {
@@ -347,7 +387,7 @@ mod tests {
         // Of the two movers (spine for the arm's cut, root for the leg's), the root wins.
         let mut regions = fresh();
         assert_eq!(
-            bind_parent_sides(&mut regions, &skeleton, &cut_parent, &[true; 5]),
+            bind_parent_sides(&mut regions, &skeleton, &cut_parent, &[true; 5], |_| vec![]),
             1
         );
         assert_eq!(regions[0].joints, vec![0]);
@@ -360,6 +400,7 @@ mod tests {
             &skeleton,
             &cut_parent,
             &[false, true, true, true, true],
+            |_| vec![],
         );
         assert_eq!(regions[0].joints, vec![1]);
         // No ancestor may take weight: the region stays without joints.
@@ -370,10 +411,36 @@ mod tests {
                 &mut regions,
                 &skeleton,
                 &[None, None, None, None, Some(0)],
-                &none
+                &none,
+                |_| vec![],
             ),
             0
         );
         assert!(regions[0].joints.is_empty());
+    }
+
+    #[test]
+    fn a_region_without_joints_nearest_to_the_cut_joints_bones_hangs_from_that_joint() {
+        // root (0) → neck (1) → head (2) → mouth (3), and root → leg (4). Region 0 lies on
+        // the parent side of the head's cut (a chin below it), region 1 is the head's.
+        let skeleton = two_branches(
+            ["root", "neck", "head", "mouth", "leg"],
+            &[Vec3::ZERO, Vec3::Y, 2.0 * Vec3::Y, 2.5 * Vec3::Y, -Vec3::Y],
+        );
+        let cut_parent = [None, None, Some(0), None, None];
+        let bind = |face_joints: Vec<u32>| {
+            let mut regions = vec![region(vec![]), region(vec![2, 3])];
+            bind_parent_sides(&mut regions, &skeleton, &cut_parent, &[true; 5], |r| {
+                assert_eq!(r, 0);
+                face_joints.clone()
+            });
+            regions[0].joints.clone()
+        };
+        // Most faces nearest to the mouth's or the head's bones: the region moves with the
+        // head; half or fewer: with the neck, the head's parent, as before.
+        assert_eq!(bind(vec![3, 3, 2, 1]), vec![2]);
+        assert_eq!(bind(vec![3, 1, 1, 4]), vec![1]);
+        assert_eq!(bind(vec![3, 2, 1, 1]), vec![1]);
+        assert_eq!(bind(vec![]), vec![1]);
     }
 }
