@@ -240,12 +240,16 @@ impl FaceSpheres {
             return None;
         }
         let mut best: Option<NearestPoint> = None;
-        let bound = |best: &Option<NearestPoint>| best.map_or(f64::INFINITY, |b| b.distance);
-        // (node, squared distance from p to its box); the tree's depth is below 32.
-        let mut stack: Vec<(u32, f64)> = Vec::with_capacity(64);
-        stack.push((0, nodes[0].distance_squared(p)));
-        while let Some((k, gap)) = stack.pop() {
-            let limit = bound(&best);
+        // The best distance so far (infinity before the first face).
+        let mut limit = f64::INFINITY;
+        // (node, squared distance from p to its box), on the call's stack: at most one
+        // node per level plus one, and the tree's depth is below 32.
+        let mut stack = [(0u32, 0.0f64); 64];
+        stack[0] = (0, nodes[0].distance_squared(p));
+        let mut size = 1;
+        while size > 0 {
+            size -= 1;
+            let (k, gap) = stack[size];
             if gap > limit * limit {
                 continue;
             }
@@ -253,7 +257,6 @@ impl FaceSpheres {
             if node.count > 0 {
                 let (start, end) = (node.start as usize, (node.start + node.count) as usize);
                 for &f in &self.bvh.faces[start..end] {
-                    let limit = bound(&best);
                     if self.centres[f as usize].distance(p) - self.radii[f as usize] > limit {
                         continue;
                     }
@@ -261,6 +264,7 @@ impl FaceSpheres {
                     let nearer = candidate.distance < limit
                         || best.is_some_and(|b| candidate.distance == b.distance && f < b.face);
                     if nearer {
+                        limit = candidate.distance;
                         best = Some(candidate);
                     }
                 }
@@ -272,11 +276,14 @@ impl FaceSpheres {
                 nodes[second as usize].distance_squared(p),
             );
             // Pushed last, popped first: the nearer child.
-            if first_gap <= second_gap {
-                stack.extend([(second, second_gap), (first, first_gap)]);
+            let (near, far) = if first_gap <= second_gap {
+                ((first, first_gap), (second, second_gap))
             } else {
-                stack.extend([(first, first_gap), (second, second_gap)]);
-            }
+                ((second, second_gap), (first, first_gap))
+            };
+            stack[size] = far;
+            stack[size + 1] = near;
+            size += 2;
         }
         best
     }
