@@ -279,6 +279,14 @@ fn load_buffers(
     Ok(buffers)
 }
 
+/// The most bytes the bufferViews over `buffer_bytes` of buffers may span in total:
+/// [`MAX_VIEW_OVERLAP`] times them plus [`VIEW_SLACK_BYTES`].
+pub(crate) fn view_span_limit(buffer_bytes: u64) -> u64 {
+    buffer_bytes
+        .saturating_mul(MAX_VIEW_OVERLAP)
+        .saturating_add(VIEW_SLACK_BYTES)
+}
+
 /// The top-level array `key` of the document; empty when absent.
 fn top_level_array<'a>(path: &Path, json: &'a Value, key: &str) -> Result<&'a [Value], IoError> {
     match json.get(key) {
@@ -296,9 +304,7 @@ fn check_view_total(path: &Path, json: &Value, buffer_bytes: u64) -> Result<(), 
         .iter()
         .filter_map(|view| view.get("byteLength").and_then(Value::as_u64))
         .fold(0u64, u64::saturating_add);
-    let limit = buffer_bytes
-        .saturating_mul(MAX_VIEW_OVERLAP)
-        .saturating_add(VIEW_SLACK_BYTES);
+    let limit = view_span_limit(buffer_bytes);
     if spanned > limit {
         return Err(IoError::invalid(
             path,

@@ -3,6 +3,7 @@
 use super::animation::append_clips;
 use super::bindings::node_positions;
 use super::builder::{component_bounds, GlbBuilder};
+use super::container::view_span_limit;
 use super::new_document::smooth_normals;
 use super::prune::{drop_orphans, References};
 use super::write::{
@@ -131,11 +132,16 @@ fn output_capacity(
             .and_then(Value::as_array)
             .map_or(&[][..], Vec::as_slice)
     };
-    let views: usize = items("bufferViews")
+    // Declared lengths, but never more than the reader lets views span (a document built
+    // by hand with absurd lengths fails in the copy, not in reserving memory).
+    let buffer_bytes = source.buffers.iter().map(|b| b.len() as u64).sum::<u64>();
+    let views = items("bufferViews")
         .iter()
         .filter_map(|view| view.get("byteLength").and_then(Value::as_u64))
-        .map(|length| length as usize + 3)
-        .sum();
+        .fold(0u64, |sum, length| {
+            sum.saturating_add(length.saturating_add(3))
+        })
+        .min(view_span_limit(buffer_bytes)) as usize;
     let images: usize = source
         .images
         .iter()
