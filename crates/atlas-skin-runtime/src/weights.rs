@@ -88,27 +88,24 @@ impl VertexWeights {
     }
 
     /// Keeps at most `max_influences` largest weights per vertex, drops zeros, merges
-    /// repeated joints and rescales every non-empty row to sum to 1.
+    /// repeated joints and rescales every non-empty row to sum to 1 ([`prune_row`]).
     pub fn pruned(&self, max_influences: usize) -> Self {
-        Self::from_rows((0..self.vertex_count()).map(|v| {
-            let mut row: Vec<(u32, f32)> = Vec::new();
-            for (j, w) in self.row(v) {
-                match row.iter_mut().find(|(k, _)| *k == j) {
-                    Some(entry) => entry.1 += w,
-                    None => row.push((j, w)),
-                }
+        let mut out = Self {
+            offsets: Vec::with_capacity(self.offsets.len().max(1)),
+            joints: Vec::with_capacity(self.joints.len()),
+            weights: Vec::with_capacity(self.weights.len()),
+        };
+        out.offsets.push(0);
+        let mut row = Vec::new();
+        for v in 0..self.vertex_count() {
+            prune_row(self.row(v), max_influences, &mut row);
+            for &(j, w) in &row {
+                out.joints.push(j);
+                out.weights.push(w);
             }
-            row.retain(|&(_, w)| w > 0.0);
-            row.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
-            row.truncate(max_influences);
-            let sum: f32 = row.iter().map(|&(_, w)| w).sum();
-            if sum > 0.0 {
-                for entry in &mut row {
-                    entry.1 /= sum;
-                }
-            }
-            row
-        }))
+            out.offsets.push(out.joints.len() as u32);
+        }
+        out
     }
 
     /// Dense #V × `joint_count` matrix, row-major.
@@ -120,6 +117,33 @@ impl VertexWeights {
             }
         }
         dense
+    }
+}
+
+/// One row of [`VertexWeights::pruned`] into `row` (cleared first): repeated joints of
+/// `entries` merged (their weights added in order), zeros dropped, sorted by decreasing
+/// weight (then joint), cut to `max_influences` and divided by its sum when positive.
+/// Callers packing rows one at a time reuse `row` instead of building a pruned copy.
+pub fn prune_row(
+    entries: impl Iterator<Item = (u32, f32)>,
+    max_influences: usize,
+    row: &mut Vec<(u32, f32)>,
+) {
+    row.clear();
+    for (j, w) in entries {
+        match row.iter_mut().find(|(k, _)| *k == j) {
+            Some(entry) => entry.1 += w,
+            None => row.push((j, w)),
+        }
+    }
+    row.retain(|&(_, w)| w > 0.0);
+    row.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+    row.truncate(max_influences);
+    let sum: f32 = row.iter().map(|&(_, w)| w).sum();
+    if sum > 0.0 {
+        for entry in row.iter_mut() {
+            entry.1 /= sum;
+        }
     }
 }
 

@@ -18,6 +18,7 @@ use crate::mesh::inside_out::turn_inside_out_pieces;
 use crate::mesh::weld::DEFAULT_WELD_TOLERANCE;
 use crate::mesh::{weld, Topology, Welded};
 use crate::overlap::{compute_overlaps, OverlapError, OverlapParams, Overlaps};
+use crate::rows::{Rows, PAR_CHUNK};
 use crate::skeleton::bones::{bone_segments, capped_extensions, nearest_bone, EXTENSION_JOINTS};
 use crate::skeleton::hierarchy::infer_hierarchy;
 use crate::skeleton::placement::{check_placement, decomposition_warnings, PlacementError};
@@ -26,7 +27,6 @@ use crate::weights::guard::guard_far_bones;
 use crate::weights::{compute_weights, SurfaceWeights, WeightCounts, WeightsError};
 use atlas_skin_runtime::{RuntimeError, Skeleton, VertexWeights};
 use glam::{DVec3, Vec3};
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 use thiserror::Error;
@@ -369,28 +369,33 @@ pub fn unweld_weights(
     debug_assert!(max_influences >= 1);
     debug_assert_eq!(stored_positions.len(), welded_of_stored.len());
     let segments = bone_segments(skeleton);
-    let rows: Vec<Vec<(u32, f32)>> = welded_of_stored
-        .par_iter()
-        .zip(stored_positions)
-        .map(|(&w, &p)| {
-            let mut row: Vec<(u32, f64)> = if (w as usize) < surface_weights.vertex_count() {
-                surface_weights.row(w as usize).collect()
+    // Rows built in chunks, each vertex's row sorted in one scratch list (a list per vertex
+    // and another for its result cost more than the sorting on a small character).
+    let rows: Rows<(u32, f32)> = Rows::par_build(
+        welded_of_stored.len(),
+        PAR_CHUNK,
+        |v, row: &mut Vec<(u32, f64)>, out| {
+            let w = welded_of_stored[v] as usize;
+            row.clear();
+            if w < surface_weights.vertex_count() {
+                row.extend(surface_weights.row(w));
             } else {
-                nearest_bone(&segments, p.as_dvec3())
-                    .map(|j| (j, 1.0))
-                    .into_iter()
-                    .collect()
-            };
+                let p = stored_positions[v].as_dvec3();
+                row.extend(nearest_bone(&segments, p).map(|j| (j, 1.0)));
+            }
             row.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
             row.truncate(max_influences);
             let total: f64 = row.iter().map(|&(_, x)| x).sum();
-            row.into_iter()
-                .filter(|_| total > 0.0)
-                .map(|(j, x)| (j, (x / total) as f32))
-                .collect()
-        })
-        .collect();
-    VertexWeights::from_rows(rows)
+            if total > 0.0 {
+                out.extend(row.iter().map(|&(j, x)| (j, (x / total) as f32)));
+            }
+        },
+    );
+    VertexWeights {
+        joints: rows.values.iter().map(|&(j, _)| j).collect(),
+        weights: rows.values.iter().map(|&(_, x)| x).collect(),
+        offsets: rows.offsets,
+    }
 }
 
 fn elapsed_ms(start: Instant) -> f64 {

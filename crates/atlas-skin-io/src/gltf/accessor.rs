@@ -52,6 +52,7 @@ impl ComponentType {
 
     /// One component as a float. Normalized integers map to [0, 1] or [-1, 1] by the
     /// formulas of glTF 2.0 §3.11 (e.g. `f = max(c / 127, -1)` for signed bytes).
+    #[inline]
     fn decode_f32(self, b: &[u8], normalized: bool) -> f32 {
         let (value, scale) = match self {
             Self::I8 => (b[0] as i8 as f32, 127.0),
@@ -73,6 +74,7 @@ impl ComponentType {
     }
 
     /// One unsigned integer component; `None` for signed and float types.
+    #[inline]
     fn decode_u32(self, b: &[u8]) -> Option<u32> {
         match self {
             Self::U8 => Some(b[0] as u32),
@@ -155,7 +157,8 @@ impl Accessor<'_> {
     }
 
     /// All elements' components, flattened, decoded by `decode` from each component's
-    /// bytes; missing dense data reads as `zero`.
+    /// bytes; missing dense data reads as `zero`. Tightly packed elements (the usual
+    /// layout) are decoded in one pass over their bytes.
     fn decode<T: Copy>(&self, zero: T, decode: impl Fn(&[u8]) -> T) -> Vec<T> {
         let size = self.component.size();
         let element_size = self.element_size();
@@ -164,6 +167,10 @@ impl Accessor<'_> {
             out.extend(bytes[..element_size].chunks_exact(size).map(&decode));
         };
         match &self.dense {
+            Some(dense) if dense.stride == element_size => {
+                let bytes = &dense.bytes[..self.count * element_size];
+                out.extend(bytes.chunks_exact(size).map(&decode));
+            }
             Some(dense) => {
                 for i in 0..self.count {
                     push_element(&mut out, &dense.bytes[i * dense.stride..]);
@@ -402,7 +409,11 @@ pub(crate) fn read_floats(
     let accessor = accessor(doc, index, expected_type).map_err(|e| used_as(e, role))?;
     doc.charge(accessor.decoded_bytes(), role)?;
     let (component, normalized) = (accessor.component, accessor.normalized);
-    Ok(accessor.decode(0.0, |b| component.decode_f32(b, normalized)))
+    // The common component type with its decoding inlined into the loop.
+    Ok(match component {
+        ComponentType::F32 => accessor.decode(0.0, |b| ComponentType::F32.decode_f32(b, false)),
+        _ => accessor.decode(0.0, |b| component.decode_f32(b, normalized)),
+    })
 }
 
 /// Accessor `index` of type `expected_type`, used as `role` (named in errors), as unsigned

@@ -4,6 +4,7 @@
 use super::accessor::ComponentType;
 use super::container::glb_bytes;
 use serde_json::{json, Map, Value};
+use std::ops::Range;
 
 /// `bufferView.target` of vertex attributes.
 pub(crate) const ARRAY_BUFFER: u32 = 34962;
@@ -20,9 +21,16 @@ impl GlbBuilder {
     /// Starts from the top-level object `json` (its `buffers` are replaced on
     /// [`GlbBuilder::finish`]).
     pub fn new(json: Map<String, Value>) -> Self {
+        Self::with_capacity(json, 0)
+    }
+
+    /// As [`GlbBuilder::new`], with room for `bytes` of binary data (and the file's
+    /// header and JSON, which [`GlbBuilder::finish`] puts in front of it) before the buffer
+    /// grows: growing copies it, and memory reserved but never written costs no page.
+    pub fn with_capacity(json: Map<String, Value>, bytes: usize) -> Self {
         Self {
             json,
-            bin: Vec::new(),
+            bin: Vec::with_capacity(bytes),
         }
     }
 
@@ -183,8 +191,57 @@ impl GlbBuilder {
             self.json
                 .insert("buffers".into(), json!([{"byteLength": self.bin.len()}]));
         }
-        glb_bytes(&Value::Object(self.json), &self.bin)
+        glb_bytes(&Value::Object(self.json), self.bin)
     }
+}
+
+/// `bin` reduced to the byte `ranges`, in order, each placed as
+/// [`GlbBuilder::append_bytes`] places it (at the next multiple of 4 plus the phase of its
+/// old start, the gap zeroed); returns the bytes and the new offset of every range.
+///
+/// The bytes are moved within `bin` when no range is written over bytes of a later range
+/// still to be moved (always the case for the views of a rewritten document: each lies
+/// after the previous one): no second buffer. Otherwise they are copied into a new one
+/// ([`keep_ranges_by_copy`], the reference).
+pub(crate) fn keep_ranges(mut bin: Vec<u8>, ranges: &[Range<usize>]) -> (Vec<u8>, Vec<usize>) {
+    let mut offsets = Vec::with_capacity(ranges.len());
+    let mut end = 0usize;
+    for range in ranges {
+        let offset = end.next_multiple_of(4) + range.start % 4;
+        offsets.push(offset);
+        end = offset + range.len();
+    }
+    // The lowest start among the ranges after each one.
+    let mut later_start = vec![bin.len(); ranges.len()];
+    for k in (1..ranges.len()).rev() {
+        later_start[k - 1] = later_start[k].min(ranges[k].start);
+    }
+    let in_place = ranges
+        .iter()
+        .zip(&offsets)
+        .zip(&later_start)
+        .all(|((range, &offset), &limit)| range.end <= bin.len() && offset + range.len() <= limit);
+    if !in_place {
+        return keep_ranges_by_copy(&bin, ranges);
+    }
+    let mut end = 0;
+    for (range, &offset) in ranges.iter().zip(&offsets) {
+        bin.copy_within(range.clone(), offset);
+        bin[end..offset].fill(0);
+        end = offset + range.len();
+    }
+    bin.truncate(end);
+    (bin, offsets)
+}
+
+/// [`keep_ranges`] by appending each range to a new buffer.
+pub(crate) fn keep_ranges_by_copy(bin: &[u8], ranges: &[Range<usize>]) -> (Vec<u8>, Vec<usize>) {
+    let mut kept = GlbBuilder::new(Map::new());
+    let offsets = ranges
+        .iter()
+        .map(|range| kept.append_bytes(&bin[range.clone()], range.start))
+        .collect();
+    (kept.bin, offsets)
 }
 
 /// Components per element of the accessor types the writers use.
@@ -219,5 +276,64 @@ fn index_component(vertex_count: usize) -> ComponentType {
         ComponentType::U16
     } else {
         ComponentType::U32
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Kept ranges moved within the buffer are the bytes of the copying reference, with
+    /// the reference's offsets, for ranges in order with and without gaps (some cases move
+    /// a range forward, some cannot be done in place), out of order and overlapping.
+    #[test]
+    fn ranges_kept_in_place_match_the_copy() {
+        let bin: Vec<u8> = (0..400u32).map(|i| (i * 7 + 3) as u8).collect();
+        let mut cases: Vec<Vec<Range<usize>>> = vec![
+            vec![],
+            vec![0..5, 6..10, 10..11, 17..40],
+            vec![3..9, 20..33, 40..41, 64..100, 150..200],
+            vec![50..60, 10..20],
+            vec![10..30, 20..40],
+            vec![0..400],
+        ];
+        // Ranges in order with random gaps (zero included) and lengths, and ranges laid out
+        // as a rewritten document's views are (each at the next multiple of 4 after the
+        // previous one, plus its phase, possibly a multiple of 4 further): those are all
+        // kept in place.
+        let mut state = 12345u64;
+        let mut next = |n: u64| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 33) % n) as usize
+        };
+        let mut written = Vec::new();
+        for case in 0..400 {
+            let mut ranges = Vec::new();
+            let mut at = next(8);
+            while at < bin.len() {
+                let end = (at + next(24)).min(bin.len());
+                ranges.push(at..end);
+                at = match case % 2 {
+                    0 => end + next(6),
+                    _ => end.next_multiple_of(4) + 4 * next(3) + next(4),
+                };
+            }
+            if case % 2 == 1 {
+                written.push(cases.len());
+            }
+            cases.push(ranges);
+        }
+        for (k, ranges) in cases.iter().enumerate() {
+            let original = bin.clone();
+            let start = original.as_ptr();
+            let kept = keep_ranges(original, ranges);
+            assert!(
+                kept.0.as_ptr() == start || !written.contains(&k),
+                "{ranges:?} not kept in place"
+            );
+            assert_eq!(kept, keep_ranges_by_copy(&bin, ranges), "{ranges:?}");
+        }
     }
 }

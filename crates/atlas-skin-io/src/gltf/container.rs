@@ -5,6 +5,7 @@
 use super::file_access::DocumentFolder;
 use crate::IoError;
 use serde_json::Value;
+use std::ops::Range;
 use std::path::Path;
 
 /// The first 4 bytes of a GLB file (glTF 2.0 §4.4.2).
@@ -35,9 +36,10 @@ pub(crate) struct Container {
 /// else must be a `.gltf` JSON file. JSON starting with a UTF-8 byte-order mark is read
 /// with a warning.
 pub(crate) fn read_container(path: &Path) -> Result<Container, IoError> {
-    let bytes = crate::text::read_bytes(path)?;
+    let mut bytes = crate::text::read_bytes(path)?;
+    let file_bytes = bytes.len() as u64;
     let is_binary_name = matches!(extension(path).as_str(), "glb" | "vrm");
-    let (json_bytes, bin) = if bytes.starts_with(GLB_MAGIC) {
+    let (json_range, bin_range) = if bytes.starts_with(GLB_MAGIC) {
         split_glb(path, &bytes)?
     } else if is_binary_name {
         let shown = &bytes[..bytes.len().min(4)];
@@ -49,9 +51,10 @@ pub(crate) fn read_container(path: &Path) -> Result<Container, IoError> {
             ),
         ));
     } else {
-        (bytes.as_slice(), None)
+        (0..bytes.len(), None)
     };
     let mut warnings = Vec::new();
+    let json_bytes = &bytes[json_range];
     let json_bytes = match json_bytes.strip_prefix(UTF8_BOM) {
         Some(rest) => {
             warnings.push(
@@ -64,6 +67,13 @@ pub(crate) fn read_container(path: &Path) -> Result<Container, IoError> {
         None => json_bytes,
     };
     let json = parse_json(path, json_bytes)?;
+    // The BIN chunk becomes buffer 0 in the file's own allocation (moved to its start)
+    // instead of a copy.
+    let bin = bin_range.map(|range| {
+        bytes.truncate(range.end);
+        bytes.drain(..range.start);
+        bytes
+    });
     let mut folder = DocumentFolder::of(path);
     let buffers = load_buffers(path, &json, bin, &mut folder)?;
     let buffer_bytes = buffers.iter().map(|b| b.len() as u64).sum();
@@ -74,7 +84,7 @@ pub(crate) fn read_container(path: &Path) -> Result<Container, IoError> {
         buffers,
         images,
         warnings,
-        input_bytes: bytes.len() as u64 + buffer_bytes + image_bytes,
+        input_bytes: file_bytes + buffer_bytes + image_bytes,
     })
 }
 
@@ -91,9 +101,9 @@ fn read_u32(bytes: &[u8], at: usize) -> Option<u32> {
     Some(u32::from_le_bytes([word[0], word[1], word[2], word[3]]))
 }
 
-/// Splits a GLB file into its JSON chunk and its BIN chunk (if any), checking the header
-/// and every chunk length against the file size.
-fn split_glb<'a>(path: &Path, bytes: &'a [u8]) -> Result<(&'a [u8], Option<Vec<u8>>), IoError> {
+/// The byte ranges of a GLB file's JSON chunk and of its BIN chunk (if any), checking the
+/// header and every chunk length against the file size.
+fn split_glb(path: &Path, bytes: &[u8]) -> Result<(Range<usize>, Option<Range<usize>>), IoError> {
     let error = |message: String| IoError::invalid(path, message);
     if bytes.len() < GLB_HEADER_BYTES {
         return Err(error(format!(
@@ -142,13 +152,13 @@ fn split_glb<'a>(path: &Path, bytes: &'a [u8]) -> Result<(&'a [u8], Option<Vec<u
             )));
         };
         match (chunk_index, kind) {
-            (0, CHUNK_JSON) => json = Some(&bytes[start..end]),
+            (0, CHUNK_JSON) => json = Some(start..end),
             (0, _) => {
                 return Err(error(format!(
                     "the first glb chunk has type 0x{kind:08X}, expected JSON (0x{CHUNK_JSON:08X})"
                 )))
             }
-            (1, CHUNK_BIN) => bin = Some(bytes[start..end].to_vec()),
+            (1, CHUNK_BIN) => bin = Some(start..end),
             // Unknown chunk types must be ignored (glTF 2.0 §4.4.3.1).
             _ => {}
         }
@@ -269,6 +279,14 @@ fn load_buffers(
     Ok(buffers)
 }
 
+/// The most bytes the bufferViews over `buffer_bytes` of buffers may span in total:
+/// [`MAX_VIEW_OVERLAP`] times them plus [`VIEW_SLACK_BYTES`].
+pub(crate) fn view_span_limit(buffer_bytes: u64) -> u64 {
+    buffer_bytes
+        .saturating_mul(MAX_VIEW_OVERLAP)
+        .saturating_add(VIEW_SLACK_BYTES)
+}
+
 /// The top-level array `key` of the document; empty when absent.
 fn top_level_array<'a>(path: &Path, json: &'a Value, key: &str) -> Result<&'a [Value], IoError> {
     match json.get(key) {
@@ -286,9 +304,7 @@ fn check_view_total(path: &Path, json: &Value, buffer_bytes: u64) -> Result<(), 
         .iter()
         .filter_map(|view| view.get("byteLength").and_then(Value::as_u64))
         .fold(0u64, u64::saturating_add);
-    let limit = buffer_bytes
-        .saturating_mul(MAX_VIEW_OVERLAP)
-        .saturating_add(VIEW_SLACK_BYTES);
+    let limit = view_span_limit(buffer_bytes);
     if spanned > limit {
         return Err(IoError::invalid(
             path,
@@ -348,30 +364,36 @@ fn load_images(
 /// to 4 bytes: JSON with spaces, BIN with zeros (glTF 2.0 §4.4.3).
 ///
 /// The JSON is serialised into bytes directly (the compact form `Value`'s `Display`
-/// writes, without going through the formatter and a `String`), and the file is
-/// allocated once at its final size (growing it would copy the BIN chunk).
-pub(crate) fn glb_bytes(json: &Value, bin: &[u8]) -> Vec<u8> {
-    let mut json_chunk = serde_json::to_vec(json).expect("a JSON value serialises into memory");
-    json_chunk.resize(json_chunk.len().next_multiple_of(4), b' ');
+/// writes, without going through the formatter and a `String`) after room for the
+/// header, and the header and JSON are then put in front of the BIN chunk inside `bin`'s
+/// own allocation (moving it there, in the room [`super::builder::GlbBuilder::with_capacity`]
+/// left when there is enough) instead of copying both into a third buffer.
+pub(crate) fn glb_bytes(json: &Value, mut bin: Vec<u8>) -> Vec<u8> {
+    let mut head = vec![0; GLB_HEADER_BYTES + CHUNK_HEADER_BYTES];
+    serde_json::to_writer(&mut head, json).expect("a JSON value serialises into memory");
+    let json_end = head.len().next_multiple_of(4);
+    head.resize(json_end, b' ');
+    let json_length = json_end - GLB_HEADER_BYTES - CHUNK_HEADER_BYTES;
     let bin_chunk_len = bin.len().next_multiple_of(4);
-    let mut total = GLB_HEADER_BYTES + CHUNK_HEADER_BYTES + json_chunk.len();
+    let mut total = json_end;
     if !bin.is_empty() {
         total += CHUNK_HEADER_BYTES + bin_chunk_len;
+        head.extend_from_slice(&(bin_chunk_len as u32).to_le_bytes());
+        head.extend_from_slice(&CHUNK_BIN.to_le_bytes());
     }
-    let mut out = Vec::with_capacity(total);
-    out.extend_from_slice(GLB_MAGIC);
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&(total as u32).to_le_bytes());
-    out.extend_from_slice(&(json_chunk.len() as u32).to_le_bytes());
-    out.extend_from_slice(&CHUNK_JSON.to_le_bytes());
-    out.extend_from_slice(&json_chunk);
-    if !bin.is_empty() {
-        out.extend_from_slice(&(bin_chunk_len as u32).to_le_bytes());
-        out.extend_from_slice(&CHUNK_BIN.to_le_bytes());
-        out.extend_from_slice(bin);
-        out.resize(total, 0);
+    head[0..4].copy_from_slice(GLB_MAGIC);
+    head[4..8].copy_from_slice(&2u32.to_le_bytes());
+    head[8..12].copy_from_slice(&(total as u32).to_le_bytes());
+    head[12..16].copy_from_slice(&(json_length as u32).to_le_bytes());
+    head[16..20].copy_from_slice(&CHUNK_JSON.to_le_bytes());
+    if bin.is_empty() {
+        return head;
     }
-    out
+    bin.resize(bin_chunk_len, 0);
+    bin.resize(total, 0);
+    bin.copy_within(0..bin_chunk_len, head.len());
+    bin[..head.len()].copy_from_slice(&head);
+    bin
 }
 
 #[cfg(test)]
@@ -381,10 +403,13 @@ mod tests {
     #[test]
     fn glb_round_trips_through_split() {
         let json = serde_json::json!({"asset": {"version": "2.0"}});
-        let bytes = glb_bytes(&json, &[1, 2, 3]);
+        let bytes = glb_bytes(&json, vec![1, 2, 3]);
         assert_eq!(bytes.len() % 4, 0);
-        let (json_bytes, bin) = split_glb(Path::new("x.glb"), &bytes).unwrap();
-        assert_eq!(parse_json(Path::new("x.glb"), json_bytes).unwrap(), json);
-        assert_eq!(&bin.unwrap()[..3], &[1, 2, 3]);
+        let (json_range, bin) = split_glb(Path::new("x.glb"), &bytes).unwrap();
+        assert_eq!(
+            parse_json(Path::new("x.glb"), &bytes[json_range]).unwrap(),
+            json
+        );
+        assert_eq!(&bytes[bin.unwrap()][..3], &[1, 2, 3]);
     }
 }

@@ -6,7 +6,7 @@
 //! A document using an extension not known to be free of such references, or holding a
 //! reference that is not a valid index, is left exactly as it is.
 
-use super::builder::GlbBuilder;
+use super::builder::{keep_ranges, GlbBuilder};
 use super::view_span::used_spans;
 use serde_json::{json, Map, Value};
 use std::ops::Range;
@@ -246,9 +246,9 @@ pub(crate) fn drop_orphans(mut builder: GlbBuilder, input: Option<&References>) 
     let Value::Object(json) = document else {
         unreachable!("the document was made an object above")
     };
-    let mut pruned = GlbBuilder::new(json);
-    for (view, range) in view_bytes.into_iter().enumerate() {
-        let offset = pruned.append_bytes(&bin[range.clone()], range.start);
+    let (bin, offsets) = keep_ranges(bin, &view_bytes);
+    let mut pruned = GlbBuilder::from_parts(json, bin);
+    for (view, (range, offset)) in view_bytes.iter().zip(offsets).enumerate() {
         let view = &mut pruned.json_mut()["bufferViews"][view];
         view["byteOffset"] = json!(offset);
         view["byteLength"] = json!(range.len());

@@ -3,6 +3,7 @@
 use super::animation::append_clips;
 use super::bindings::node_positions;
 use super::builder::{component_bounds, GlbBuilder};
+use super::container::view_span_limit;
 use super::new_document::smooth_normals;
 use super::prune::{drop_orphans, References};
 use super::write::{
@@ -43,7 +44,8 @@ pub(crate) fn rewrite_document(
     };
     let skinned_meshes: BTreeSet<usize> = source.primitives.iter().map(|p| p.mesh).collect();
     refuse_joints_with_skinned_meshes(&json, source.skin, &skinned_meshes, input)?;
-    let mut builder = GlbBuilder::new(json);
+    let capacity = output_capacity(&json, source, character, options);
+    let mut builder = GlbBuilder::with_capacity(json, capacity);
     let input_references = References::of_input(builder.json_mut());
     copy_buffer_views(&mut builder, source, input)?;
     embed_images(&mut builder, source, input)?;
@@ -113,6 +115,52 @@ pub(crate) fn rewrite_document(
     }
     Ok(drop_orphans(builder, input_references.as_ref()).finish())
 }
+
+/// Room for the output's bytes, so that its buffer is allocated once (see
+/// [`GlbBuilder::with_capacity`]; an estimate: too little only costs a copy): the input's
+/// bufferViews and images with their alignment, the new weights (at most 32 bytes per
+/// vertex and set of 4), inverse bind matrices, and [`JSON_BYTES_PER_ITEM`] per item of
+/// the document's top-level arrays for the header and JSON put in front at the end.
+fn output_capacity(
+    json: &Map<String, Value>,
+    source: &GltfSource,
+    character: &Character,
+    options: &WriteOptions,
+) -> usize {
+    let items = |key: &str| {
+        json.get(key)
+            .and_then(Value::as_array)
+            .map_or(&[][..], Vec::as_slice)
+    };
+    // Declared lengths, but never more than the reader lets views span (a document built
+    // by hand with absurd lengths fails in the copy, not in reserving memory).
+    let buffer_bytes = source.buffers.iter().map(|b| b.len() as u64).sum::<u64>();
+    let views = items("bufferViews")
+        .iter()
+        .filter_map(|view| view.get("byteLength").and_then(Value::as_u64))
+        .fold(0u64, |sum, length| {
+            sum.saturating_add(length.saturating_add(3))
+        })
+        .min(view_span_limit(buffer_bytes)) as usize;
+    let images: usize = source
+        .images
+        .iter()
+        .flatten()
+        .map(|i| i.bytes.len() + 3)
+        .sum();
+    let weights = 32 * options.max_influences.div_ceil(4) * character.mesh.positions.len();
+    let inverse_binds = 64 * character.skeleton.as_ref().map_or(0, |s| s.len());
+    let json_items: usize = json
+        .values()
+        .filter_map(Value::as_array)
+        .map(Vec::len)
+        .sum();
+    views + images + weights + inverse_binds + JSON_BYTES_PER_ITEM * (json_items + 16)
+}
+
+/// Room per item of the document's top-level arrays (accessors, nodes, ...) for the
+/// output's JSON in [`output_capacity`]: more than an accessor with its bounds takes.
+const JSON_BYTES_PER_ITEM: usize = 256;
 
 /// Refuses a document where a joint of `skin` instantiates one of the skinned `meshes`: the
 /// mesh would move with a joint that its own weights move (and a node with a skinned mesh
@@ -512,12 +560,9 @@ fn in_skin_order(
         .iter()
         .map(|node| skin_index.get(node).copied().unwrap_or(0))
         .collect();
-    VertexWeights::from_rows(vertices.map(|v| {
-        weights
-            .row(v)
-            .map(|(j, w)| (index_in_skin[j as usize], w))
-            .collect::<Vec<_>>()
-    }))
+    VertexWeights::from_rows(
+        vertices.map(|v| weights.row(v).map(|(j, w)| (index_in_skin[j as usize], w))),
+    )
 }
 
 /// Node index of every joint of `skin`.

@@ -7,6 +7,7 @@ use super::new_document::new_document;
 use super::rewrite::rewrite_document;
 use crate::output::OutputPlan;
 use crate::{Character, IoError};
+use atlas_skin_runtime::weights::prune_row;
 use atlas_skin_runtime::{Clip, Skeleton, VertexWeights};
 use serde_json::{Map, Value};
 use std::path::Path;
@@ -131,14 +132,12 @@ pub(crate) fn pack_weights(
 ) -> PackedWeights {
     let sets = max_influences.div_ceil(4);
     let vertex_count = vertices.len();
-    let pruned = VertexWeights::from_rows(vertices.map(|v| weights.row(v))).pruned(max_influences);
     let mut joints = vec![vec![0u32; 4 * vertex_count]; sets];
     let mut packed = vec![vec![0f32; 4 * vertex_count]; sets];
     // Buffers reused by every vertex.
     let (mut row, mut stored) = (Vec::new(), Vec::new());
-    for v in 0..vertex_count {
-        row.clear();
-        row.extend(pruned.row(v));
+    for (v, vertex) in vertices.enumerate() {
+        prune_row(weights.row(vertex), max_influences, &mut row);
         if row.is_empty() {
             row.push((0, 1.0));
         }

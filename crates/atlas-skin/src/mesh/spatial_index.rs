@@ -12,7 +12,6 @@ use crate::geometry::closest_point_on_triangle;
 use crate::rows::Rows;
 use crate::tolerance::RAY_PARALLEL;
 use glam::{DVec3, IVec3};
-use rayon::slice::ParallelSliceMut;
 
 /// A bounding sphere per face (centre = centroid, radius = farthest corner from it), and
 /// a grid of the centres.
@@ -241,12 +240,16 @@ impl FaceSpheres {
             return None;
         }
         let mut best: Option<NearestPoint> = None;
-        let bound = |best: &Option<NearestPoint>| best.map_or(f64::INFINITY, |b| b.distance);
-        // (node, squared distance from p to its box); the tree's depth is below 32.
-        let mut stack: Vec<(u32, f64)> = Vec::with_capacity(64);
-        stack.push((0, nodes[0].distance_squared(p)));
-        while let Some((k, gap)) = stack.pop() {
-            let limit = bound(&best);
+        // The best distance so far (infinity before the first face).
+        let mut limit = f64::INFINITY;
+        // (node, squared distance from p to its box), on the call's stack: at most one
+        // node per level plus one, and the tree's depth is below 32.
+        let mut stack = [(0u32, 0.0f64); 64];
+        stack[0] = (0, nodes[0].distance_squared(p));
+        let mut size = 1;
+        while size > 0 {
+            size -= 1;
+            let (k, gap) = stack[size];
             if gap > limit * limit {
                 continue;
             }
@@ -254,7 +257,6 @@ impl FaceSpheres {
             if node.count > 0 {
                 let (start, end) = (node.start as usize, (node.start + node.count) as usize);
                 for &f in &self.bvh.faces[start..end] {
-                    let limit = bound(&best);
                     if self.centres[f as usize].distance(p) - self.radii[f as usize] > limit {
                         continue;
                     }
@@ -262,6 +264,7 @@ impl FaceSpheres {
                     let nearer = candidate.distance < limit
                         || best.is_some_and(|b| candidate.distance == b.distance && f < b.face);
                     if nearer {
+                        limit = candidate.distance;
                         best = Some(candidate);
                     }
                 }
@@ -273,11 +276,14 @@ impl FaceSpheres {
                 nodes[second as usize].distance_squared(p),
             );
             // Pushed last, popped first: the nearer child.
-            if first_gap <= second_gap {
-                stack.extend([(second, second_gap), (first, first_gap)]);
+            let (near, far) = if first_gap <= second_gap {
+                ((first, first_gap), (second, second_gap))
             } else {
-                stack.extend([(first, first_gap), (second, second_gap)]);
-            }
+                ((second, second_gap), (first, first_gap))
+            };
+            stack[size] = far;
+            stack[size + 1] = near;
+            size += 2;
         }
         best
     }
@@ -456,15 +462,14 @@ impl FaceBvh {
             .collect();
         let (centre_lo, centre_hi) = crate::geometry::bounding_box(centres);
         let scale = MORTON_CELLS / (centre_hi - centre_lo).max(DVec3::splat(f64::MIN_POSITIVE));
-        let mut keyed: Vec<(u64, u32)> = centres
+        let keyed: Vec<(u64, u32)> = centres
             .iter()
             .enumerate()
             .map(|(f, c)| (morton_code(((*c - centre_lo) * scale).as_uvec3()), f as u32))
             .collect();
-        keyed.par_sort_unstable();
         let mut bvh = Self {
             nodes: Vec::with_capacity(2 * centres.len() / LEAF_FACES + 1),
-            faces: keyed.into_iter().map(|(_, f)| f).collect(),
+            faces: sort_by_code(keyed).into_iter().map(|(_, f)| f).collect(),
         };
         if !bvh.faces.is_empty() {
             bvh.build(0..bvh.faces.len(), &boxes);
@@ -498,6 +503,44 @@ impl FaceBvh {
         (self.nodes[index].lo, self.nodes[index].hi) = (lo, hi);
         [lo, hi]
     }
+}
+
+/// Bits of the code sorted by each pass of [`sort_by_code`].
+const RADIX_BITS: u32 = 11;
+
+/// `keyed` (Morton codes of 63 bits with their faces, the faces increasing) sorted by code
+/// and then face, as `sort_unstable` sorts the pairs: a least significant digit radix
+/// sort, ⌈63 / 11⌉ = 6 counting passes of 2¹¹ buckets, O(F) (a pass whose digit is the
+/// same for every code is skipped). Each pass is stable, so faces of one code stay
+/// increasing. (The comparison sort it replaces took about 200 instructions per face; the
+/// passes about 40.)
+fn sort_by_code(mut keyed: Vec<(u64, u32)>) -> Vec<(u64, u32)> {
+    const BUCKETS: usize = 1 << RADIX_BITS;
+    debug_assert!(keyed.windows(2).all(|w| w[0].1 < w[1].1));
+    let mut other = vec![(0u64, 0u32); keyed.len()];
+    let mut counts = vec![0usize; BUCKETS];
+    for pass in 0..63u32.div_ceil(RADIX_BITS) {
+        let shift = pass * RADIX_BITS;
+        let digit = |code: u64| ((code >> shift) as usize) & (BUCKETS - 1);
+        counts.fill(0);
+        for &(code, _) in &keyed {
+            counts[digit(code)] += 1;
+        }
+        if counts.contains(&keyed.len()) {
+            continue;
+        }
+        let mut next = 0;
+        for count in counts.iter_mut() {
+            (*count, next) = (next, next + *count);
+        }
+        for &(code, face) in &keyed {
+            let slot = &mut counts[digit(code)];
+            other[*slot] = (code, face);
+            *slot += 1;
+        }
+        std::mem::swap(&mut keyed, &mut other);
+    }
+    keyed
 }
 
 /// Cells per axis of the Morton code's grid (21 bits per axis fill 63 bits).
@@ -741,6 +784,29 @@ mod tests {
         assert_eq!(code(3, 5, 6), 0b110_101_011);
         let top = (1 << 21) - 1;
         assert_eq!(code(top, top, top), (1u64 << 63) - 1);
+    }
+
+    #[test]
+    fn codes_sort_by_radix_as_by_comparison() {
+        // Random codes of 63 bits, codes repeated (faces of one code must stay in order),
+        // codes differing only in their top or bottom digit, none and one face.
+        let mut state = 7u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            state >> 1
+        };
+        let random: Vec<u64> = (0..5000).map(|_| next()).collect();
+        let repeated: Vec<u64> = (0..3000).map(|_| (next() % 17) << 40).collect();
+        let top: Vec<u64> = (0..300).map(|i| ((i % 5) << 60) | 12345).collect();
+        let bottom: Vec<u64> = (0..300).map(|i| (i * 7919) % 2048).collect();
+        for codes in [random, repeated, top, bottom, vec![], vec![5]] {
+            let keyed: Vec<(u64, u32)> = codes.iter().zip(0..).map(|(&c, f)| (c, f)).collect();
+            let mut expected = keyed.clone();
+            expected.sort_unstable();
+            assert_eq!(sort_by_code(keyed), expected);
+        }
     }
 
     #[test]

@@ -37,8 +37,12 @@ impl SurfaceMesh {
     }
 
     /// The three corner positions of triangle `f`.
+    #[inline]
     pub fn corners(&self, f: usize) -> [DVec3; 3] {
-        self.triangles[f].map(|v| self.positions[v as usize])
+        // Indexed one by one: `array::map` was not inlined (a call and copies per face).
+        let [a, b, c] = self.triangles[f];
+        let at = |v: u32| self.positions[v as usize];
+        [at(a), at(b), at(c)]
     }
 
     /// Area-weighted normal of triangle `f`: `(b − a) × (c − a)`, of length twice its area.

@@ -56,16 +56,22 @@ pub fn weld(positions: &[Vec3], triangles: &[[u32; 3]], relative_tolerance: f64)
     welded_from_sets(&stored, triangles, &used, &mut sets)
 }
 
+/// Side of a cell of [`close_pairs`]' grid, in tolerances.
+const CELL_TOLERANCES: f64 = 64.0;
+
 /// Calls `pair(u, v)` for every pair u < v of `used` vertices (in increasing order) at
 /// most `tolerance` apart (and possibly for others: the caller merges them only through
 /// union–find, where a pair found twice changes nothing, so every qualifying pair is
 /// reported at least once and no other).
 ///
-/// A hash grid of cell size s = 2 × tolerance with origin `lo`: a point at offset x
-/// within its cell c along an axis (0 ≤ x < s) has every point within `tolerance` in
-/// cell c and in c − 1 when x < s / 2, c + 1 otherwise (a margin of 1/64 of a cell
-/// around s / 2 looks both ways, against rounding), so each vertex looks into 8 cells
-/// (27 at most), each a list threaded through `next`. Expected O(V).
+/// A hash grid of cell size s = [`CELL_TOLERANCES`] × tolerance with origin `lo`: a point
+/// at offset x within its cell c along an axis (0 ≤ x < s) has every point within
+/// `tolerance` in cell c, and also in c − 1 when x is within reach r = tolerance · 33/32
+/// of the cell's lower side, in c + 1 when within r of its upper side (the 1/32 a margin
+/// against rounding). Most points look into their own cell only, and a cell holds only
+/// points within s of each other (on a real mesh, the copies of a seam vertex). Expected
+/// O(V). (With cells of 2 × tolerance every point looked into 8 cells: 8 hash look-ups per
+/// vertex, the weld's largest cost.)
 fn close_pairs(
     stored: &[DVec3],
     used: &[u32],
@@ -74,8 +80,8 @@ fn close_pairs(
     mut pair: impl FnMut(u32, u32),
 ) {
     const NONE: u32 = u32::MAX;
-    const MARGIN: f64 = 1.0 / 64.0;
-    let cell_size = 2.0 * tolerance;
+    let cell_size = CELL_TOLERANCES * tolerance;
+    let reach = (1.0 + 1.0 / 32.0) / CELL_TOLERANCES;
     let mut first_in_cell: FxHashMap<[i64; 3], u32> = FxHashMap::default();
     first_in_cell.reserve(used.len());
     let mut next = vec![NONE; stored.len()];
@@ -85,10 +91,11 @@ fn close_pairs(
         let cell = scaled.floor();
         let offset = scaled - cell;
         let steps = |x: f64| -> &'static [i64] {
-            match (x < 0.5 + MARGIN, x > 0.5 - MARGIN) {
+            match (x < reach, x > 1.0 - reach) {
                 (true, true) => &[-1, 0, 1],
                 (true, false) => &[-1, 0],
-                _ => &[0, 1],
+                (false, true) => &[0, 1],
+                (false, false) => &[0],
             }
         };
         let c = [cell.x as i64, cell.y as i64, cell.z as i64];
@@ -225,6 +232,37 @@ mod tests {
             assert_eq!(fast.mesh.triangles, reference.mesh.triangles, "case {case}");
             assert_eq!(fast.referenced_stored, reference.referenced_stored);
         }
+    }
+
+    /// Pairs just closer and just farther than the tolerance across the grid's cell sides
+    /// (the first point at the origin, so that the sides are at multiples of the cell
+    /// size), along one axis and across edges and corners of cells: welded as the
+    /// reference welds them.
+    #[test]
+    fn pairs_across_cell_sides_weld_as_the_reference() {
+        let relative = 1e-3;
+        let far = Vec3::splat(1.0);
+        let tolerance = relative * (far.as_dvec3().length());
+        let cell = (CELL_TOLERANCES * tolerance) as f32;
+        let t = tolerance as f32;
+        let mut positions = vec![Vec3::ZERO, far];
+        for k in 1..6 {
+            let side = k as f32 * cell;
+            for (before, after) in [(0.4, 0.5), (0.1, 0.85), (0.6, 0.6), (0.0, 0.99), (0.9, 0.0)] {
+                for direction in [Vec3::X, Vec3::Y, Vec3::Z, Vec3::ONE.normalize()] {
+                    let start = Vec3::splat(side) - direction * before * t;
+                    positions.push(start);
+                    positions.push(start + direction * (before + after) * t);
+                }
+            }
+        }
+        let n = positions.len() as u32;
+        let triangles: Vec<[u32; 3]> = (0..n).map(|k| [k, k, k]).collect();
+        let fast = weld(&positions, &triangles, relative);
+        let reference = reference_weld(&positions, &triangles, relative);
+        assert_eq!(fast.welded_of_stored, reference.welded_of_stored);
+        let merged = n as usize - fast.mesh.vertex_count();
+        assert!(merged > 50, "{merged} merged");
     }
 
     #[test]

@@ -25,6 +25,7 @@ pub mod shared_sides;
 use crate::cuts::plane_section::Plane;
 use crate::decomposition::Region;
 use crate::mesh::{SurfaceMesh, Topology};
+use crate::rows::Rows;
 use crate::skeleton::bone_tree::BoneTree;
 #[cfg(doc)]
 use crate::skeleton::bones::bone_segments;
@@ -150,18 +151,31 @@ pub fn bind_regions(
         };
     }
 
-    let mut faces = vec![0usize; region_count];
-    // A vertex on a cut loop counts once for each region it borders.
-    let mut incidences: Vec<(u32, u32)> = Vec::with_capacity(3 * mesh.triangle_count());
-    for (f, t) in mesh.triangles.iter().enumerate() {
-        faces[face_region[f] as usize] += 1;
-        incidences.extend(t.iter().map(|&v| (face_region[f], v)));
-    }
-    incidences.sort_unstable();
-    incidences.dedup();
+    // A vertex on a cut loop counts once for each region it borders: the faces grouped by
+    // region (a counting sort), each vertex counted at the first face of a region that
+    // uses it (O(V + F), where sorting the 3F (region, vertex) pairs took 15% of the
+    // decomposition of a small character).
+    let region_faces = Rows::group(
+        region_count,
+        face_region
+            .iter()
+            .enumerate()
+            .map(|(f, &r)| (r as usize, f as u32)),
+    );
+    let faces: Vec<usize> = (0..region_count)
+        .map(|r| region_faces.row(r).len())
+        .collect();
     let mut vertices = vec![0usize; region_count];
-    for (r, _) in incidences {
-        vertices[r as usize] += 1;
+    let mut counted_in = vec![u32::MAX; mesh.positions.len()];
+    for (r, count) in vertices.iter_mut().enumerate() {
+        for &f in region_faces.row(r) {
+            for &v in &mesh.triangles[f as usize] {
+                if counted_in[v as usize] != r as u32 {
+                    counted_in[v as usize] = r as u32;
+                    *count += 1;
+                }
+            }
+        }
     }
     let mut joints: Vec<Vec<u32>> = vec![Vec::new(); region_count];
     for &j in &order {
