@@ -701,32 +701,8 @@ mod tests {
     /// turned axes (the rays the decomposition casts), by the hierarchy and by a full scan.
     #[test]
     fn hierarchy_queries_match_a_full_scan_on_the_corpus() {
-        use atlas_skin_io::{load_character, LoadOptions};
-        let models = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/models");
-        let cases = [
-            (
-                "makehuman/base.obj",
-                Some("makehuman/default.mhskel"),
-                Some("body"),
-            ),
-            ("cesiumman/CesiumMan.glb", None, None),
-        ];
         let turn = glam::DQuat::from_euler(glam::EulerRot::XYZ, 0.1234, 0.2345, 0.3456);
-        for (file, skeleton, group) in cases {
-            let options = LoadOptions {
-                skeleton: skeleton.map(|s| std::path::Path::new(models).join(s)),
-                group: group.map(String::from),
-                ..Default::default()
-            };
-            let character = load_character(&std::path::Path::new(models).join(file), &options)
-                .unwrap_or_else(|e| panic!("the corpus is needed: {file}: {e}"));
-            let welded = crate::mesh::weld(
-                &character.mesh.positions,
-                &character.mesh.triangles,
-                crate::mesh::weld::DEFAULT_WELD_TOLERANCE,
-            );
-            let mesh = welded.mesh;
-            let skeleton = character.skeleton.expect("the model has a skeleton");
+        for (file, mesh, skeleton) in crate::fixtures::corpus::welded_humans() {
             let joints: Vec<DVec3> = skeleton
                 .bind_positions()
                 .iter()
