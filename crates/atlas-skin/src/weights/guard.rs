@@ -65,7 +65,7 @@ pub fn guard_far_bones(
     if suspects.is_empty() {
         return 0;
     }
-    let spheres = FaceSpheres::new(surface);
+    let spheres = decomposition.surface_spheres();
     let mut changed = 0;
     let replaced: Rows<(u32, f64)> = Rows::par_build(
         suspects.len(),
@@ -73,8 +73,7 @@ pub fn guard_far_bones(
         |k, _: &mut (), out: &mut Vec<(u32, f64)>| {
             let v = suspects[k];
             let p = surface.positions[v];
-            let Some((near_joint, near)) = nearest_seen_bone(surface, &spheres, &segments, p)
-            else {
+            let Some((near_joint, near)) = nearest_seen_bone(surface, spheres, &segments, p) else {
                 out.extend(weights.row(v));
                 return;
             };
