@@ -312,9 +312,18 @@ impl BodySurface {
     }
 
     /// The weights of the nearest point of the body surface to `p`, interpolated over its
-    /// face, with the distance; `None` when there is no body surface.
-    fn weights_at(&self, weights: &SurfaceWeights, p: DVec3) -> Option<BodyPoint> {
-        let nearest = self.spheres.nearest_point(&self.mesh, p)?;
+    /// face, with the distance; `None` when there is no body surface. `hint`: the nearest
+    /// face of the query before (a vertex of the same piece, usually nearby), where the
+    /// search starts ([`FaceSpheres::nearest_point_from`]: the same answer); set to this
+    /// query's.
+    fn weights_at(
+        &self,
+        weights: &SurfaceWeights,
+        p: DVec3,
+        hint: &mut Option<u32>,
+    ) -> Option<BodyPoint> {
+        let nearest = self.spheres.nearest_point_from(&self.mesh, p, *hint)?;
+        *hint = Some(nearest.face);
         let corners = self.mesh.triangles[nearest.face as usize];
         let mut row: Vec<(u32, f64)> = Vec::new();
         for (&v, &b) in corners.iter().zip(&nearest.barycentric) {
@@ -371,7 +380,10 @@ impl LoosePiece<'_> {
         let on_body = || -> Vec<Option<BodyPoint>> {
             positions
                 .par_iter()
-                .map(|&p| self.body.weights_at(self.weights, p))
+                .map_init(
+                    || None,
+                    |hint, &p| self.body.weights_at(self.weights, p, hint),
+                )
                 .collect()
         };
         let (lo, hi) = crate::geometry::bounding_box(&positions);
