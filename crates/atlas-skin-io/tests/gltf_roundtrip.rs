@@ -213,6 +213,29 @@ fn corpus_round_trip_keeps_everything_but_the_weights() {
     assert_valid(&outputs);
 }
 
+/// The writer that takes the input's document instead of copying it writes the same bytes,
+/// and leaves no document behind.
+#[test]
+fn taking_the_document_writes_the_same_bytes() {
+    let dir = out_dir("taking_the_document");
+    let mut inputs: Vec<PathBuf> = GLTF_MODELS
+        .iter()
+        .map(|(model, file)| model_path(model, file))
+        .collect();
+    inputs.push(decorated_simpleskin(&dir));
+    for input in inputs {
+        let mut character = gltf::read(&input).unwrap();
+        let weights = character.reference_weights.clone().unwrap();
+        let out = dir.join("out.glb");
+        let options = WriteOptions::default();
+        let copied = gltf::skinned_glb(&character, &weights, &options, &out).unwrap();
+        let taken =
+            gltf::skinned_glb_taking_document(&mut character, &weights, &options, &out).unwrap();
+        assert!(copied == taken, "{}", input.display());
+        assert_eq!(character.gltf.unwrap().document, Value::Null);
+    }
+}
+
 /// Eight influences per vertex go into JOINTS_0/1 and WEIGHTS_0/1; with four, the input's
 /// second set is removed.
 #[test]

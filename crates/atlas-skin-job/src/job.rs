@@ -9,7 +9,7 @@ use crate::report::{skin_report, stage_timings, vertex_ranges};
 use crate::settings::{Settings, SettingsError};
 use atlas_skin::pipeline::{skin, SkinError, SkinInput, Skinned};
 use atlas_skin::report::{debug_colors, debug_lines};
-use atlas_skin_io::gltf::{debug_glb, skinned_glb, WriteOptions};
+use atlas_skin_io::gltf::{debug_glb, skinned_glb_taking_document, WriteOptions};
 use atlas_skin_io::{Character, IoError, LoadOptions, OutputPlan, TriangleMesh};
 use glam::Vec3;
 use serde_json::{json, Value};
@@ -177,7 +177,7 @@ impl SkinJob {
             outputs.paths(),
         )?;
         let params = self.settings.params()?;
-        let character = self.input.load()?;
+        let mut character = self.input.load()?;
         let Some(skeleton) = character.skeleton.clone() else {
             return Err(JobError::NoSkeleton {
                 path: character.path.clone(),
@@ -205,7 +205,9 @@ impl SkinJob {
             max_influences: params.max_influences,
             ..WriteOptions::default()
         };
-        let glb = skinned_glb(&character, &skinned.weights, &options, &outputs.glb)?;
+        // Nothing below reads the input's JSON document: it goes into the output uncopied.
+        let glb =
+            skinned_glb_taking_document(&mut character, &skinned.weights, &options, &outputs.glb)?;
         plan.write(&outputs.glb, &glb)?;
         timings.insert("write".into(), json!(start.elapsed().as_secs_f64() * 1e3));
 

@@ -127,11 +127,15 @@ pub fn decompose(
         .map(|plan| !matches!(plan, JointPlan::Exclude(_)))
         .collect();
     // On one connected surface a joint without a cut lies in its parent's region (§3.2);
-    // the faces of the split surface are indexed only for a surface of several pieces
-    // with a soft joint.
+    // the faces of the split surface are indexed here only for a surface of several pieces
+    // with a soft joint (the index is kept for the weights).
+    let surface_spheres = std::sync::OnceLock::new();
     let holders = (outcomes.iter().any(|o| matches!(o, Outcome::Soft { .. }))
         && topology.vertex_components(mesh).1 > 1)
-        .then(|| HoldingRegions::new(&surface, &face_region));
+        .then(|| {
+            let spheres = surface_spheres.get_or_init(|| FaceSpheres::new(&surface));
+            HoldingRegions::new(&surface, &face_region, spheres)
+        });
     let holding = |j: usize, parent_region: Option<u32>| match (&outcomes[j], &holders) {
         (Outcome::Soft { frame, .. }, Some(holders)) => {
             let (_, _, diameter) = section_geometry(frame, searches[j].candidates.first());
@@ -149,7 +153,6 @@ pub fn decompose(
         &cut_parent,
         holding,
     );
-    drop(holders);
 
     let (boundaries, mut joints) = decide_joints(skeleton, outcomes, &joint_region, &searches);
     for (decision, &owns) in joints.iter_mut().zip(&owns_skin) {
@@ -174,6 +177,7 @@ pub fn decompose(
         boundaries,
         joints,
         shared_sides,
+        surface_spheres,
     })
 }
 

@@ -1,10 +1,11 @@
 //! The result of the decomposition stages (§3.1 cuts, §3.2 regions): what the weights stage
 //! (§3.3–§5) reads. Plain data; [`crate::decompose()`] builds it.
 
-use crate::mesh::{SurfaceMesh, Topology};
+use crate::mesh::{FaceSpheres, SurfaceMesh, Topology};
 use crate::regions::shared_sides::SharedSide;
 use glam::DVec3;
 use serde::Serialize;
+use std::sync::OnceLock;
 
 /// The surface split along the cut curves, its regions and the boundaries between them.
 #[derive(Debug, Clone)]
@@ -26,6 +27,18 @@ pub struct Decomposition {
     /// Regions that were the child side of the cuts of unrelated joints (a hand fused to
     /// the hip) and were divided among them ([`crate::regions::shared_sides`]).
     pub shared_sides: Vec<SharedSide>,
+    /// The face index of `surface`, built by the first [`Decomposition::surface_spheres`]
+    /// (the holding regions of soft joints and the guard against far bones share it);
+    /// empty (`OnceLock::new()`) when the decomposition is made.
+    pub surface_spheres: OnceLock<FaceSpheres>,
+}
+
+impl Decomposition {
+    /// The face index of the split surface, built on first use.
+    pub fn surface_spheres(&self) -> &FaceSpheres {
+        self.surface_spheres
+            .get_or_init(|| FaceSpheres::new(&self.surface))
+    }
 }
 
 /// A connected part of the split surface.

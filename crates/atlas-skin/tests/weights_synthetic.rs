@@ -172,6 +172,7 @@ fn decompose_by_hand(
         boundaries,
         joints,
         shared_sides: Vec::new(),
+        surface_spheres: Default::default(),
     }
 }
 

@@ -31,12 +31,13 @@ use std::path::Path;
 pub(crate) fn rewrite_document(
     character: &Character,
     source: &GltfSource,
+    document: Value,
     weights: &VertexWeights,
     options: &WriteOptions,
     out: &Path,
 ) -> Result<Vec<u8>, IoError> {
     let input = &character.path;
-    let Value::Object(json) = source.document.clone() else {
+    let Value::Object(json) = document else {
         return Err(IoError::invalid(
             input,
             "the glTF document is not a JSON object",
@@ -50,7 +51,8 @@ pub(crate) fn rewrite_document(
     copy_buffer_views(&mut builder, source, input)?;
     embed_images(&mut builder, source, input)?;
 
-    let joint_nodes = skin_joint_nodes(&source.document, source.skin, input)?;
+    // The skins are read from the output's document, which has them as the input had.
+    let joint_nodes = skin_joint_nodes(builder.json_mut(), source.skin, input)?;
     let joint_count = character.skeleton.as_ref().map_or(0, |s| s.len());
     if joint_count != joint_nodes.len() {
         return Err(IoError::invalid(
@@ -71,11 +73,12 @@ pub(crate) fn rewrite_document(
         };
         let first = primitive.vertices.start;
         if let std::collections::btree_map::Entry::Vacant(entry) = block_sets.entry(first) {
+            let skin_nodes = skin_joint_nodes(builder.json_mut(), Some(skin), input)?;
             let skin_weights = in_skin_order(
                 weights,
                 primitive.vertices.clone(),
                 &joint_nodes,
-                &skin_joint_nodes(&source.document, Some(skin), input)?,
+                &skin_nodes,
             );
             let packed = pack_weights(
                 &skin_weights,
@@ -567,7 +570,7 @@ fn in_skin_order(
 
 /// Node index of every joint of `skin`.
 fn skin_joint_nodes(
-    document: &Value,
+    document: &Map<String, Value>,
     skin: Option<usize>,
     input: &Path,
 ) -> Result<Vec<usize>, IoError> {

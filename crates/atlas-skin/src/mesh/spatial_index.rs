@@ -235,13 +235,29 @@ impl FaceSpheres {
     /// (`nearest_point_by_scan` in the tests): a face can be skipped only when its bound
     /// exceeds a distance already found, so it can neither win nor tie.
     pub fn nearest_point(&self, mesh: &SurfaceMesh, p: DVec3) -> Option<NearestPoint> {
+        self.nearest_point_from(mesh, p, None)
+    }
+
+    /// [`Self::nearest_point`], the search started from face `hint` (a face near `p`: the
+    /// nearest face of a neighbouring query point) instead of from nothing. The same
+    /// result: the hint is one candidate among the others, tested first, so its distance
+    /// prunes boxes and faces from the start (a face is still skipped only when its bound
+    /// exceeds a distance found).
+    pub fn nearest_point_from(
+        &self,
+        mesh: &SurfaceMesh,
+        p: DVec3,
+        hint: Option<u32>,
+    ) -> Option<NearestPoint> {
         let nodes = &self.bvh.nodes;
         if nodes.is_empty() {
             return None;
         }
-        let mut best: Option<NearestPoint> = None;
+        let mut best: Option<NearestPoint> = hint
+            .filter(|&f| (f as usize) < self.centres.len())
+            .map(|f| NearestPoint::on_face(mesh, f, p));
         // The best distance so far (infinity before the first face).
-        let mut limit = f64::INFINITY;
+        let mut limit = best.map_or(f64::INFINITY, |b| b.distance);
         // (node, squared distance from p to its box), on the call's stack: at most one
         // node per level plus one, and the tree's depth is below 32.
         let mut stack = [(0u32, 0.0f64); 64];
@@ -701,32 +717,8 @@ mod tests {
     /// turned axes (the rays the decomposition casts), by the hierarchy and by a full scan.
     #[test]
     fn hierarchy_queries_match_a_full_scan_on_the_corpus() {
-        use atlas_skin_io::{load_character, LoadOptions};
-        let models = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/models");
-        let cases = [
-            (
-                "makehuman/base.obj",
-                Some("makehuman/default.mhskel"),
-                Some("body"),
-            ),
-            ("cesiumman/CesiumMan.glb", None, None),
-        ];
         let turn = glam::DQuat::from_euler(glam::EulerRot::XYZ, 0.1234, 0.2345, 0.3456);
-        for (file, skeleton, group) in cases {
-            let options = LoadOptions {
-                skeleton: skeleton.map(|s| std::path::Path::new(models).join(s)),
-                group: group.map(String::from),
-                ..Default::default()
-            };
-            let character = load_character(&std::path::Path::new(models).join(file), &options)
-                .unwrap_or_else(|e| panic!("the corpus is needed: {file}: {e}"));
-            let welded = crate::mesh::weld(
-                &character.mesh.positions,
-                &character.mesh.triangles,
-                crate::mesh::weld::DEFAULT_WELD_TOLERANCE,
-            );
-            let mesh = welded.mesh;
-            let skeleton = character.skeleton.expect("the model has a skeleton");
+        for (file, mesh, skeleton) in crate::fixtures::corpus::welded_humans() {
             let joints: Vec<DVec3> = skeleton
                 .bind_positions()
                 .iter()
@@ -748,12 +740,17 @@ mod tests {
                 ];
                 for direction in axes.into_iter().map(|a| turn * a).chain(bone) {
                     // The nearest surface point of points inside and around the body.
+                    let mut hint = None;
                     for q in [p, p + direction * 0.1, p + direction] {
+                        let scan = nearest_point_by_scan(&mesh, q);
+                        assert_eq!(spheres.nearest_point(&mesh, q), scan, "{file} joint {j}");
+                        // From the nearest face of the point before, as the pieces ask.
                         assert_eq!(
-                            spheres.nearest_point(&mesh, q),
-                            nearest_point_by_scan(&mesh, q),
+                            spheres.nearest_point_from(&mesh, q, hint),
+                            scan,
                             "{file} joint {j}"
                         );
+                        hint = scan.map(|s| s.face);
                     }
                     let fast = spheres.first_hit(&mesh, p, direction);
                     let scan = first_hit_by_scan(&mesh, p, direction);
@@ -837,6 +834,7 @@ mod tests {
         let (mesh, _) = crate::fixtures::shapes::bent_cylinder(0.5, 3.0, 70.0, 24, 12);
         let spheres = FaceSpheres::new(&mesh);
         let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut previous = 0;
         for query in 0..400 {
             let mut next = || {
                 state ^= state << 13;
@@ -850,6 +848,17 @@ mod tests {
             let scan = nearest_point_by_scan(&mesh, p).expect("faces");
             assert_eq!(spheres.nearest_point(&mesh, p), Some(scan), "{p}");
             assert_eq!(spheres.nearest_distance(&mesh, p), scan.distance);
+            // Started from the answer, from a random face, from the previous query's face
+            // or from no face (an index past the faces): the same answer.
+            let random = (next() * mesh.triangle_count() as f64) as u32;
+            for hint in [scan.face, random, previous, mesh.triangle_count() as u32] {
+                assert_eq!(
+                    spheres.nearest_point_from(&mesh, p, Some(hint)),
+                    Some(scan),
+                    "{p} from {hint}"
+                );
+            }
+            previous = scan.face;
             let scan_distance = (0..mesh.triangle_count())
                 .map(|f| {
                     let [a, b, c] = mesh.corners(f);

@@ -29,16 +29,17 @@ pub const REACH: f64 = 2.0;
 pub struct HoldingRegions<'a> {
     mesh: &'a SurfaceMesh,
     face_region: &'a [u32],
-    spheres: FaceSpheres,
+    spheres: &'a FaceSpheres,
 }
 
 impl<'a> HoldingRegions<'a> {
-    /// Indexes the faces of `mesh` (the split surface), `face_region` the region of each.
-    pub fn new(mesh: &'a SurfaceMesh, face_region: &'a [u32]) -> Self {
+    /// The faces of `mesh` (the split surface) indexed by `spheres`, `face_region` the
+    /// region of each.
+    pub fn new(mesh: &'a SurfaceMesh, face_region: &'a [u32], spheres: &'a FaceSpheres) -> Self {
         Self {
             mesh,
             face_region,
-            spheres: FaceSpheres::new(mesh),
+            spheres,
         }
     }
 
@@ -101,7 +102,8 @@ mod tests {
     #[test]
     fn a_joint_inside_another_piece_than_its_parents_region_is_held_by_that_piece() {
         let (mesh, face_region) = two_balls();
-        let holders = HoldingRegions::new(&mesh, &face_region);
+        let spheres = FaceSpheres::new(&mesh);
+        let holders = HoldingRegions::new(&mesh, &face_region, &spheres);
         // At the centre of the small ball: its surface lies about 0.3 away, the big
         // ball's about 4: d_N + ρ D = 0.3 + 2 × 0.6 falls short of it.
         let centre = DVec3::new(5.0, 0.0, 0.0);
@@ -119,7 +121,8 @@ mod tests {
     #[test]
     fn a_surface_without_faces_keeps_the_parents_region() {
         let mesh = SurfaceMesh::default();
-        let holders = HoldingRegions::new(&mesh, &[]);
+        let spheres = FaceSpheres::new(&mesh);
+        let holders = HoldingRegions::new(&mesh, &[], &spheres);
         assert_eq!(holders.holding_region(DVec3::ZERO, 1.0, Some(3)), Some(3));
         assert_eq!(holders.holding_region(DVec3::ZERO, 1.0, None), None);
     }

@@ -20,7 +20,7 @@
 
 use super::surface_weights::SurfaceWeights;
 use crate::decomposition::Decomposition;
-use crate::geometry::segment_parameter;
+use crate::geometry::{point_segment_distance, segment_parameter};
 use crate::mesh::FaceSpheres;
 use crate::rows::{Rows, PAR_CHUNK};
 use crate::skeleton::bone_tree::{BoneTree, Keys, Split};
@@ -56,29 +56,16 @@ pub fn guard_far_bones(
         return 0;
     }
     let floor = NEAR_FLOOR * surface.diagonal();
-    // All the segments in one tree for the nearest, and keyed by joint for each joint's
-    // nearest (a descent each, instead of a scan of every bone, or of the hundreds of child
-    // bones of one joint, per vertex).
-    let bone_tree =
-        BoneTree::of_segments(&segments.iter().map(|&(_, a, b)| [a, b]).collect::<Vec<_>>());
-    let joint_tree = BoneTree::new(segments.iter().copied(), Split::Keys);
-    let joint_distance = |p: DVec3, joint: u32| {
-        joint_tree.nearest_distance(p, Keys::Inside(joint, joint + 1), |_, _| true)
-    };
+    let far = FarJoints::new(&segments, skeleton.len(), floor);
     // Vertices with a joint that is far even from the nearest bone by straight line: only
     // they need the line-of-sight test.
     let suspects: Vec<usize> = (0..weights.vertex_count())
-        .filter(|&v| {
-            let p = surface.positions[v];
-            let nearest = bone_tree.nearest(p);
-            let limit = FAR_BONE_RATIO * nearest.max(floor);
-            weights.row(v).any(|(j, _)| joint_distance(p, j) > limit)
-        })
+        .filter(|&v| far.any_far(surface.positions[v], weights.row(v).map(|(j, _)| j)))
         .collect();
     if suspects.is_empty() {
         return 0;
     }
-    let spheres = FaceSpheres::new(surface);
+    let spheres = decomposition.surface_spheres();
     let mut changed = 0;
     let replaced: Rows<(u32, f64)> = Rows::par_build(
         suspects.len(),
@@ -86,15 +73,14 @@ pub fn guard_far_bones(
         |k, _: &mut (), out: &mut Vec<(u32, f64)>| {
             let v = suspects[k];
             let p = surface.positions[v];
-            let Some((near_joint, near)) = nearest_seen_bone(surface, &spheres, &segments, p)
-            else {
+            let Some((near_joint, near)) = nearest_seen_bone(surface, spheres, &segments, p) else {
                 out.extend(weights.row(v));
                 return;
             };
             let limit = FAR_BONE_RATIO * near.max(floor);
             let kept: Vec<(u32, f64)> = weights
                 .row(v)
-                .filter(|&(j, _)| joint_distance(p, j) <= limit)
+                .filter(|&(j, _)| far.joint_distance(p, j) <= limit)
                 .collect();
             let total: f64 = kept.iter().map(|&(_, w)| w).sum();
             if total > 0.0 {
@@ -125,6 +111,89 @@ pub fn guard_far_bones(
     }
     *weights = result;
     changed
+}
+
+/// How many of a joint's bone segments [`FarJoints`] keeps for its upper bound.
+const BOUND_SEGMENTS: usize = 4;
+
+/// The straight-line test of the guard: whether a weighted joint j of a vertex p is far
+/// even from the nearest bone of all, d_j > R · max(d_min, ε · D) with d_min the distance
+/// to the nearest bone segment (a vertex passing it is then tested for a line of sight).
+struct FarJoints {
+    /// All the segments in one tree, for d_min.
+    bone_tree: BoneTree,
+    /// The segments keyed by joint, for each d_j (a descent each, instead of a scan of
+    /// every bone, or of the hundreds of child bones of one joint, per vertex).
+    joint_tree: BoneTree,
+    /// Up to [`BOUND_SEGMENTS`] segments of each joint: the distance to the nearest of
+    /// them bounds d_j from above.
+    bound_segments: Vec<Vec<[DVec3; 2]>>,
+    /// ε · D.
+    floor: f64,
+}
+
+impl FarJoints {
+    fn new(segments: &[(u32, DVec3, DVec3)], joint_count: usize, floor: f64) -> Self {
+        let mut bound_segments = vec![Vec::new(); joint_count];
+        for &(j, a, b) in segments {
+            let kept: &mut Vec<[DVec3; 2]> = &mut bound_segments[j as usize];
+            if kept.len() < BOUND_SEGMENTS {
+                kept.push([a, b]);
+            }
+        }
+        Self {
+            bone_tree: BoneTree::of_segments(
+                &segments.iter().map(|&(_, a, b)| [a, b]).collect::<Vec<_>>(),
+            ),
+            joint_tree: BoneTree::new(segments.iter().copied(), Split::Keys),
+            bound_segments,
+            floor,
+        }
+    }
+
+    /// d_j: the distance from `p` to the nearest bone segment of `joint` (infinity without).
+    fn joint_distance(&self, p: DVec3, joint: u32) -> f64 {
+        self.joint_tree
+            .nearest_distance(p, Keys::Inside(joint, joint + 1), |_, _| true)
+    }
+
+    /// Whether a joint of `joints` is far from `p`: the same answer as
+    /// [`FarJoints::any_far_by_trees`], with fewer tree descents. A joint is far only when
+    /// d_j > R · max(d_min, ε · D) ≥ R ε D (the rounded product is monotonic in its
+    /// factor), so a joint with a segment nearer than R ε D is not far and needs no
+    /// descent: d_j is at most the distance u_j to its nearest segment of
+    /// `bound_segments`, up to the tree's rounding (it skips a box whose computed distance
+    /// equals its best, while a segment in it may compute a few units in the last place
+    /// less), which a slack of 10⁻⁹ of the coordinates' size covers: the test is
+    /// u_j + slack ≤ R ε D. d_min is found only when some d_j exceeds R ε D.
+    fn any_far(&self, p: DVec3, joints: impl IntoIterator<Item = u32>) -> bool {
+        let reach = FAR_BONE_RATIO * self.floor;
+        let mut limit: Option<f64> = None;
+        joints.into_iter().any(|j| {
+            let near_segment = self.bound_segments[j as usize].iter().any(|&[a, b]| {
+                let slack = 1e-9 * (p.abs() + a.abs() + b.abs()).max_element();
+                point_segment_distance(p, a, b) + slack <= reach
+            });
+            if near_segment {
+                return false;
+            }
+            let distance = self.joint_distance(p, j);
+            distance > reach
+                && distance
+                    > *limit.get_or_insert_with(|| {
+                        FAR_BONE_RATIO * self.bone_tree.nearest(p).max(self.floor)
+                    })
+        })
+    }
+
+    /// The reference of [`FarJoints::any_far`]: d_min and every d_j by a tree descent.
+    #[cfg(test)]
+    fn any_far_by_trees(&self, p: DVec3, joints: impl IntoIterator<Item = u32>) -> bool {
+        let limit = FAR_BONE_RATIO * self.bone_tree.nearest(p).max(self.floor);
+        joints
+            .into_iter()
+            .any(|j| self.joint_distance(p, j) > limit)
+    }
 }
 
 /// The joint and distance of the nearest bone segment whose nearest point to `p` is seen
@@ -166,6 +235,57 @@ mod tests {
     use crate::fixtures::shapes::capsule_chain;
     use crate::mesh::Topology;
     use crate::skeleton::bones::nearest_bone;
+
+    /// The far-joint test with its bounds against every distance by the trees: every vertex
+    /// of cesiumman and makehuman's body with each joint alone and with all of them, and
+    /// points around a bone at R ε D and a few units in the last place either side of it.
+    #[test]
+    fn far_joints_match_the_trees() {
+        for (file, mesh, skeleton) in crate::fixtures::corpus::welded_humans() {
+            let segments = bone_segments(&skeleton);
+            let far = FarJoints::new(&segments, skeleton.len(), NEAR_FLOOR * mesh.diagonal());
+            let all = 0..skeleton.len() as u32;
+            let mut far_count = 0;
+            for &p in &mesh.positions {
+                for j in all.clone() {
+                    let expected = far.any_far_by_trees(p, [j]);
+                    assert_eq!(far.any_far(p, [j]), expected, "{file}: {p} joint {j}");
+                    far_count += usize::from(expected);
+                }
+                assert_eq!(
+                    far.any_far(p, all.clone()),
+                    far.any_far_by_trees(p, all.clone())
+                );
+            }
+            assert!(far_count > 0, "{file}: some joints are far");
+        }
+        // One bone along X and a far one: points at R ε D from the first bone and a few
+        // units in the last place either side, where the bound and the tree must agree.
+        let segments = [
+            (0, DVec3::new(-1.0, 0.0, 0.0), DVec3::new(1.0, 0.0, 0.0)),
+            (1, DVec3::new(0.0, 50.0, 0.0), DVec3::new(0.0, 60.0, 0.0)),
+        ];
+        let floor = 0.04;
+        let far = FarJoints::new(&segments, 2, floor);
+        let reach = FAR_BONE_RATIO * floor;
+        let mut checked = 0;
+        for x in [-1.5, -1.0, 0.0, 0.3, 1.0, 1.2] {
+            for ulps in -4i64..=4 {
+                let y = f64::from_bits((reach.to_bits() as i64 + ulps) as u64);
+                for p in [DVec3::new(x, y, 0.0), DVec3::new(x, 0.0, -y)] {
+                    for joints in [vec![0], vec![1], vec![0, 1]] {
+                        assert_eq!(
+                            far.any_far(p, joints.iter().copied()),
+                            far.any_far_by_trees(p, joints.iter().copied()),
+                            "{p} {joints:?}"
+                        );
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert_eq!(checked, 6 * 9 * 2 * 3);
+    }
 
     #[test]
     fn weight_on_a_far_bone_goes_to_the_bones_near_the_vertex() {

@@ -91,6 +91,7 @@ use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::collections::{BinaryHeap, HashMap};
+use std::sync::OnceLock;
 
 /// Step 4: weights every vertex steps 1–3 left without weights, piece by piece (module
 /// documentation); returns the counts and how each piece was weighted.
@@ -171,11 +172,14 @@ pub fn weight_pieces(
         if pass.is_empty() {
             continue;
         }
-        let body = BodySurface::new(surface, &body_faces, &current);
+        // Indexed only when a piece of the pass asks for it (in many passes every piece is
+        // rigid to its held bones).
+        let body = OnceLock::new();
         let loose_piece = LoosePiece {
             surface,
             topology: &decomposition.topology,
             body: &body,
+            body_faces: &body_faces,
             weights: &current,
             skeleton,
             planes: &planes,
@@ -312,9 +316,18 @@ impl BodySurface {
     }
 
     /// The weights of the nearest point of the body surface to `p`, interpolated over its
-    /// face, with the distance; `None` when there is no body surface.
-    fn weights_at(&self, weights: &SurfaceWeights, p: DVec3) -> Option<BodyPoint> {
-        let nearest = self.spheres.nearest_point(&self.mesh, p)?;
+    /// face, with the distance; `None` when there is no body surface. `hint`: the nearest
+    /// face of the query before (a vertex of the same piece, usually nearby), where the
+    /// search starts ([`FaceSpheres::nearest_point_from`]: the same answer); set to this
+    /// query's.
+    fn weights_at(
+        &self,
+        weights: &SurfaceWeights,
+        p: DVec3,
+        hint: &mut Option<u32>,
+    ) -> Option<BodyPoint> {
+        let nearest = self.spheres.nearest_point_from(&self.mesh, p, *hint)?;
+        *hint = Some(nearest.face);
         let corners = self.mesh.triangles[nearest.face as usize];
         let mut row: Vec<(u32, f64)> = Vec::new();
         for (&v, &b) in corners.iter().zip(&nearest.barycentric) {
@@ -346,13 +359,20 @@ type Row = Vec<(u32, f64)>;
 struct LoosePiece<'a> {
     surface: &'a SurfaceMesh,
     topology: &'a Topology,
-    body: &'a BodySurface,
+    /// The body surface of `body_faces` with `weights`, built on first use.
+    body: &'a OnceLock<BodySurface>,
+    body_faces: &'a [[u32; 3]],
     weights: &'a SurfaceWeights,
     skeleton: &'a Skeleton,
     planes: &'a [Option<Plane>],
 }
 
 impl LoosePiece<'_> {
+    fn body(&self) -> &BodySurface {
+        self.body
+            .get_or_init(|| BodySurface::new(self.surface, self.body_faces, self.weights))
+    }
+
     /// Weights one piece without joints (module documentation): how, and the row of each
     /// of `vertices`. `candidates` (not empty): the bones it holds when `holds`, else every
     /// bone, narrowed to the bones of the joints that carry its contact. The body surface
@@ -371,7 +391,10 @@ impl LoosePiece<'_> {
         let on_body = || -> Vec<Option<BodyPoint>> {
             positions
                 .par_iter()
-                .map(|&p| self.body.weights_at(self.weights, p))
+                .map_init(
+                    || None,
+                    |hint, &p| self.body().weights_at(self.weights, p, hint),
+                )
                 .collect()
         };
         let (lo, hi) = crate::geometry::bounding_box(&positions);
