@@ -21,7 +21,8 @@ use crate::mesh::{FaceSpheres, SurfaceMesh, Topology};
 use crate::regions::holding::HoldingRegions;
 use crate::regions::shared_sides::{divide_shared_sides, ChildSide};
 use crate::regions::{
-    bind_parent_sides, bind_regions, grow_regions, nearest_bone_joints, side_regions,
+    bind_parent_sides, bind_regions, faces_by_region, grow_regions, nearest_bone_joints,
+    side_regions,
 };
 use crate::skeleton::bone_tree::BoneTree;
 use crate::skeleton::bones::{bone_segments, joint_pairs, BoneIndex};
@@ -143,10 +144,11 @@ pub fn decompose(
         }
         _ => parent_region,
     };
+    let region_faces = faces_by_region(&face_region, region_count);
     let (joint_region, mut regions) = bind_regions(
         &surface,
         &face_region,
-        region_count,
+        &region_faces,
         skeleton,
         &positions,
         &sides(true),
@@ -166,7 +168,7 @@ pub fn decompose(
             let ends: Vec<[DVec3; 2]> = segments.iter().map(|&(_, a, b)| [a, b]).collect();
             (segments, BoneTree::of_segments(&ends))
         });
-        nearest_bone_joints(&surface, &face_region, r, tree, segments)
+        nearest_bone_joints(&surface, region_faces.row(r as usize), tree, segments)
     });
     Ok(Decomposition {
         topology: split_topology,

@@ -78,6 +78,15 @@ pub fn grow_regions(
     (region, count as usize)
 }
 
+/// The faces of each of `region_count` regions, by increasing face (a counting sort of
+/// `face_region`).
+pub fn faces_by_region(face_region: &[u32], region_count: usize) -> Rows<u32> {
+    Rows::group(
+        region_count,
+        (0u32..).zip(face_region).map(|(f, &r)| (r as usize, f)),
+    )
+}
+
 /// The edge joining `a` and `b` (edges are sorted, so a binary search).
 fn find_edge(topology: &Topology, a: u32, b: u32) -> Option<usize> {
     topology.edges.binary_search(&[a.min(b), a.max(b)]).ok()
@@ -114,6 +123,7 @@ pub fn side_regions(
 
 /// Regions of joints and the regions' joint lists (see the module doc).
 ///
+/// - `region_faces`: the faces of each region ([`faces_by_region`]).
 /// - `cut_child`: #J child region of every joint with a separating cut, `None` otherwise.
 /// - `cut_parent`: #J parent region of the same cuts.
 /// - `positions`: #J bind positions.
@@ -130,7 +140,7 @@ pub fn side_regions(
 pub fn bind_regions(
     mesh: &SurfaceMesh,
     face_region: &[u32],
-    region_count: usize,
+    region_faces: &Rows<u32>,
     skeleton: &Skeleton,
     positions: &[DVec3],
     cut_child: &[Option<u32>],
@@ -151,17 +161,10 @@ pub fn bind_regions(
         };
     }
 
-    // A vertex on a cut loop counts once for each region it borders: the faces grouped by
-    // region (a counting sort), each vertex counted at the first face of a region that
-    // uses it (O(V + F), where sorting the 3F (region, vertex) pairs took 15% of the
-    // decomposition of a small character).
-    let region_faces = Rows::group(
-        region_count,
-        face_region
-            .iter()
-            .enumerate()
-            .map(|(f, &r)| (r as usize, f as u32)),
-    );
+    // A vertex on a cut loop counts once for each region it borders: each vertex counted
+    // at the first face of a region that uses it (O(V + F), where sorting the 3F (region,
+    // vertex) pairs took 15% of the decomposition of a small character).
+    let region_count = region_faces.len();
     let faces: Vec<usize> = (0..region_count)
         .map(|r| region_faces.row(r).len())
         .collect();
@@ -279,19 +282,18 @@ pub fn bind_parent_sides(
     bound
 }
 
-/// The joint of the bone segment ([`bone_segments`]) nearest to the centroid of each face
-/// of region `region`, in face order.
+/// The joint of the bone segment ([`bone_segments`], indexed by `bones`) nearest to the
+/// centroid of each of `faces`, in their order.
 pub fn nearest_bone_joints(
     mesh: &SurfaceMesh,
-    face_region: &[u32],
-    region: u32,
+    faces: &[u32],
     bones: &BoneTree,
     segments: &[(u32, DVec3, DVec3)],
 ) -> Vec<u32> {
-    (0..mesh.triangle_count())
-        .filter(|&f| face_region[f] == region)
-        .filter_map(|f| {
-            let [a, b, c] = mesh.corners(f);
+    faces
+        .iter()
+        .filter_map(|&f| {
+            let [a, b, c] = mesh.corners(f as usize);
             let p = (a + b + c) / 3.0;
             let nearest = bones.within(p, bones.nearest(p)).into_iter().next()?;
             Some(segments[nearest as usize].0)
@@ -358,7 +360,7 @@ mod tests {
         let (joint_region, regions) = bind_regions(
             &mesh,
             &face_region,
-            4,
+            &faces_by_region(&face_region, 4),
             &skeleton,
             &skeleton
                 .bind_positions()
