@@ -139,8 +139,10 @@ pub fn decompose(
         });
     let holding = |j: usize, parent_region: Option<u32>| match (&outcomes[j], &holders) {
         (Outcome::Soft { frame, .. }, Some(holders)) => {
-            let (_, _, diameter) = section_geometry(frame, searches[j].candidates.first());
-            holders.holding_region(frame.position, diameter, parent_region)
+            let section = searches[j].candidates.first();
+            let (_, _, diameter) = section_geometry(frame, section);
+            let points = section.map_or(&[][..], |c| &c.points[..]);
+            holders.holding_region(frame.position, points, diameter, parent_region)
         }
         _ => parent_region,
     };
@@ -327,7 +329,7 @@ fn held_elsewhere(
 ) -> String {
     match skeleton.parent(j).map(|p| joint_region[p]) {
         Some(Some(parent_region)) if joint_region[j] != Some(parent_region) => format!(
-            "{reason}; its parent's region {parent_region} does not reach its section: it \
+            "{reason}; its parent's region {parent_region} does not hold its section: it \
              acts in the region around it, {}",
             joint_region[j].map_or("none".to_string(), |r| r.to_string())
         ),

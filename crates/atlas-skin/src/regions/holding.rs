@@ -9,12 +9,19 @@
 //! ([`crate::weights::soft_sides`]), and the piece around it moves with whatever joint
 //! the rules for regions without joints give it.
 //!
-//! The rule: with d_N the distance from the joint to the nearest face of the surface and
-//! D the diameter of the joint's section (its best closed section, else 2 d_N, as the
-//! soft boundary's), the parent's region holds the joint when one of its faces lies
-//! within d_N + ρ D of it (ρ = [`REACH`]): it reaches the joint's cross-section. Otherwise
-//! the region of the nearest face holds it ([`super::bind_regions`] says what that region
-//! is bound to).
+//! The rule, in two steps:
+//! 1. A joint whose section (the best closed section of its soft boundary) lies on one
+//!    region — more than half of the section's points are nearest to that region's
+//!    faces — is held by that region: its boundary acts where its cross-section runs (a
+//!    spine joint whose parent's region is a belt, while its section runs around the
+//!    dress's torso; docs/pieces.md, "The section's region").
+//! 2. Otherwise, with d_N the distance from the joint to the nearest face of the surface
+//!    and D the diameter of the joint's section (its best closed section, else 2 d_N, as
+//!    the soft boundary's), the parent's region holds the joint when one of its faces lies
+//!    within d_N + ρ D of it (ρ = [`REACH`]): it reaches the joint's cross-section. Else
+//!    the region of the nearest face holds it.
+//!
+//! [`super::bind_regions`] says what the holding region is bound to.
 
 use crate::mesh::{FaceSpheres, NearestPoint, SurfaceMesh};
 use glam::DVec3;
@@ -43,15 +50,21 @@ impl<'a> HoldingRegions<'a> {
         }
     }
 
-    /// The region holding a soft joint at `position` whose section has diameter
-    /// `diameter` when its parent lies in `parent_region` (module documentation):
-    /// `parent_region` when it reaches the joint, else the region of the nearest face.
+    /// The region holding a soft joint at `position` when its parent lies in
+    /// `parent_region` (module documentation): the region of more than half of `section`
+    /// (the points of its best closed section, empty without one), else `parent_region`
+    /// when it reaches the joint across `diameter`, the section's diameter, else the
+    /// region of the nearest face.
     pub fn holding_region(
         &self,
         position: DVec3,
+        section: &[DVec3],
         diameter: f64,
         parent_region: Option<u32>,
     ) -> Option<u32> {
+        if let Some(region) = self.section_region(section) {
+            return Some(region);
+        }
         let Some(nearest) = self.spheres.nearest_point(self.mesh, position) else {
             return parent_region;
         };
@@ -70,6 +83,21 @@ impl<'a> HoldingRegions<'a> {
             .filter(|&f| self.face_region[f as usize] == parent)
             .any(|f| NearestPoint::on_face(self.mesh, f, position).distance <= reach);
         Some(if reaches { parent } else { nearest_region })
+    }
+
+    /// The region whose faces are nearest to more than half of `points` (step 1 of the
+    /// rule), if any.
+    fn section_region(&self, points: &[DVec3]) -> Option<u32> {
+        let mut regions: Vec<u32> = points
+            .iter()
+            .filter_map(|&p| self.spheres.nearest_point(self.mesh, p))
+            .map(|nearest| self.face_region[nearest.face as usize])
+            .collect();
+        regions.sort_unstable();
+        regions
+            .chunk_by(|a, b| a == b)
+            .find(|run| 2 * run.len() > points.len())
+            .map(|run| run[0])
     }
 }
 
@@ -107,15 +135,60 @@ mod tests {
         // At the centre of the small ball: its surface lies about 0.3 away, the big
         // ball's about 4: d_N + ρ D = 0.3 + 2 × 0.6 falls short of it.
         let centre = DVec3::new(5.0, 0.0, 0.0);
-        assert_eq!(holders.holding_region(centre, 0.6, Some(0)), Some(1));
+        assert_eq!(holders.holding_region(centre, &[], 0.6, Some(0)), Some(1));
         // A section wide enough to reach the big ball keeps the parent's region:
         // 0.3 + 2 × 2 ≥ 4.
-        assert_eq!(holders.holding_region(centre, 2.0, Some(0)), Some(0));
+        assert_eq!(holders.holding_region(centre, &[], 2.0, Some(0)), Some(0));
         // Its own region, or none, is always answered by the nearest piece.
-        assert_eq!(holders.holding_region(centre, 0.6, Some(1)), Some(1));
-        assert_eq!(holders.holding_region(centre, 0.6, None), Some(1));
+        assert_eq!(holders.holding_region(centre, &[], 0.6, Some(1)), Some(1));
+        assert_eq!(holders.holding_region(centre, &[], 0.6, None), Some(1));
         // Inside the big ball the parent's region holds the joint.
-        assert_eq!(holders.holding_region(DVec3::ZERO, 0.6, Some(0)), Some(0));
+        assert_eq!(
+            holders.holding_region(DVec3::ZERO, &[], 0.6, Some(0)),
+            Some(0)
+        );
+    }
+
+    /// Points on the circle of radius `radius` about `centre` in the plane z = 0.
+    fn circle(centre: DVec3, radius: f64, count: usize) -> Vec<DVec3> {
+        (0..count)
+            .map(|k| {
+                let angle = std::f64::consts::TAU * k as f64 / count as f64;
+                centre + radius * DVec3::new(angle.cos(), angle.sin(), 0.0)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_joint_is_held_by_the_region_its_section_runs_on() {
+        let (mesh, face_region) = two_balls();
+        let spheres = FaceSpheres::new(&mesh);
+        let holders = HoldingRegions::new(&mesh, &face_region, &spheres);
+        let centre = DVec3::new(5.0, 0.0, 0.0);
+        let section = circle(centre, 0.3, 24);
+        // A section wide enough for the parent's region to reach the joint (as above):
+        // the section runs on the small ball, which holds the joint.
+        assert_eq!(
+            holders.holding_region(centre, &section, 2.0, Some(0)),
+            Some(1)
+        );
+        // A section around the big ball keeps the joint there, even at the small ball.
+        let around_big = circle(DVec3::ZERO, 1.0, 24);
+        assert_eq!(
+            holders.holding_region(centre, &around_big, 0.6, Some(1)),
+            Some(0)
+        );
+        // Half on each: no region holds the section, the distances decide (as above).
+        let mut halves = circle(centre, 0.3, 12);
+        halves.extend(circle(DVec3::ZERO, 1.0, 12));
+        assert_eq!(
+            holders.holding_region(centre, &halves, 2.0, Some(0)),
+            Some(0)
+        );
+        assert_eq!(
+            holders.holding_region(centre, &halves, 0.6, Some(0)),
+            Some(1)
+        );
     }
 
     #[test]
@@ -123,7 +196,10 @@ mod tests {
         let mesh = SurfaceMesh::default();
         let spheres = FaceSpheres::new(&mesh);
         let holders = HoldingRegions::new(&mesh, &[], &spheres);
-        assert_eq!(holders.holding_region(DVec3::ZERO, 1.0, Some(3)), Some(3));
-        assert_eq!(holders.holding_region(DVec3::ZERO, 1.0, None), None);
+        assert_eq!(
+            holders.holding_region(DVec3::ZERO, &[], 1.0, Some(3)),
+            Some(3)
+        );
+        assert_eq!(holders.holding_region(DVec3::ZERO, &[], 1.0, None), None);
     }
 }
