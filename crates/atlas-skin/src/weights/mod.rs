@@ -71,6 +71,7 @@
 //! them into weights per stored vertex ([`crate::pipeline::unweld_weights`]).
 
 pub mod blend;
+pub mod carriers;
 pub mod chains;
 pub mod guard;
 pub mod ownership;

@@ -26,7 +26,9 @@
 //!    where the body under it bends. A piece that holds no bone takes them only in its
 //!    contact zone; every other vertex takes the row of the contact vertex nearest to it
 //!    along the piece's edges (a lock of hair moves with the scalp it grows from, not with
-//!    the shoulder its tip hangs over).
+//!    the shoulder its tip hangs over). The piece then moves with one part of the
+//!    skeleton, the one that carries most of it ([`super::carriers`]: a knee pad reaching
+//!    onto the other knee stays on its own).
 //! 3. **rigid** to J when the piece is small next to J's bone: its bounding-box diagonal
 //!    is at most L_J, the length of J's longest bone segment.
 //! 4. **joints** otherwise: the piece spans a joint with no body beneath and no cut of its
@@ -78,6 +80,7 @@
 //! .0079 → .0030, 3615 .0046 → .0022 and max .269 → .071; 10563 +5%, 7219 +5%), the clean
 //! corpus unchanged. No vertex of a piece is left to a fallback.
 
+use super::carriers::on_one_carrier;
 pub use super::surface_weights::{GapWeighting, PieceTreatment, PieceWeighting};
 use super::surface_weights::{SurfaceWeights, WeightCounts};
 use crate::decomposition::Decomposition;
@@ -184,16 +187,22 @@ pub fn weight_pieces(
             skeleton,
             planes: &planes,
         };
-        let weighted: Vec<(PieceTreatment, Vec<Row>)> = pass
+        let weighted: Vec<UnitWeights> = pass
             .par_iter()
             .map(|&k| {
                 let candidates = if holding { &held[k] } else { &segments };
                 loose_piece.weight(&units[k].vertices, candidates, holding)
             })
             .collect();
-        for (&k, (treatment, unit_rows)) in pass.iter().zip(weighted) {
+        for (&k, weighted) in pass.iter().zip(weighted) {
+            let UnitWeights {
+                treatment,
+                rows: unit_rows,
+                off_carrier,
+            } = weighted;
             let unit = &units[k];
             let count = unit.vertices.len();
+            counts.off_carrier += off_carrier;
             match treatment {
                 PieceTreatment::Attached => counts.attached += count,
                 PieceTreatment::Rigid(_) => counts.rigid += count,
@@ -355,6 +364,15 @@ struct BodyPoint {
 /// A row of (joint, weight) pairs.
 type Row = Vec<(u32, f64)>;
 
+/// How one unit (a piece or a gap) was weighted: its treatment, the row of each of its
+/// vertices, and how many rows lost the weights of joints off the piece's carrier
+/// ([`on_one_carrier`]).
+struct UnitWeights {
+    treatment: PieceTreatment,
+    rows: Vec<Row>,
+    off_carrier: usize,
+}
+
 /// What weighting a piece without joints needs besides the piece.
 struct LoosePiece<'a> {
     surface: &'a SurfaceMesh,
@@ -383,7 +401,7 @@ impl LoosePiece<'_> {
         vertices: &[u32],
         candidates: &[(u32, DVec3, DVec3)],
         holds: bool,
-    ) -> (PieceTreatment, Vec<Row>) {
+    ) -> UnitWeights {
         let positions: Vec<DVec3> = vertices
             .iter()
             .map(|&v| self.surface.positions[v as usize])
@@ -425,11 +443,10 @@ impl LoosePiece<'_> {
             .map(|&p| nearest_bone_with_distance(candidates, p))
             .collect();
         let joints: Vec<Option<u32>> = bones.iter().map(|b| b.map(|b| b.joint)).collect();
-        let rigid = |joint: u32| {
-            (
-                PieceTreatment::Rigid(joint),
-                vec![vec![(joint, 1.0)]; vertices.len()],
-            )
+        let rigid = |joint: u32| UnitWeights {
+            treatment: PieceTreatment::Rigid(joint),
+            rows: vec![vec![(joint, 1.0)]; vertices.len()],
+            off_carrier: 0,
         };
         let dominant = most_frequent(&joints).unwrap_or(candidates[0].0);
         if joints.iter().all(|&j| j == Some(dominant)) {
@@ -441,14 +458,27 @@ impl LoosePiece<'_> {
                 .is_some_and(|at| at.distance < bone.map_or(f64::INFINITY, |b| b.distance))
         });
         if attached {
+            let body_rows: Vec<Row> = points
+                .into_iter()
+                .map(|at| at.map(|at| at.row).unwrap_or_default())
+                .collect();
             let rows = match &contact {
-                Some(touch) => self.carried_from_contact(vertices, &touch.vertices, &points),
-                None => points
-                    .into_iter()
-                    .map(|at| at.map(|at| at.row).unwrap_or_default())
-                    .collect(),
+                Some(touch) => self.carried_along(vertices, &touch.vertices, &body_rows),
+                None => body_rows,
             };
-            return (PieceTreatment::Attached, rows);
+            let Some((kept, keeps)) = on_one_carrier(self.skeleton, &rows) else {
+                return UnitWeights {
+                    treatment: PieceTreatment::Attached,
+                    rows,
+                    off_carrier: 0,
+                };
+            };
+            let carried = self.carried_along(vertices, &keeps, &kept);
+            return UnitWeights {
+                treatment: PieceTreatment::Attached,
+                off_carrier: rows.iter().zip(&carried).filter(|(a, b)| a != b).count(),
+                rows: carried,
+            };
         }
         if size <= longest_bone(candidates, dominant) {
             return rigid(dominant);
@@ -466,24 +496,25 @@ impl LoosePiece<'_> {
         };
         let bend = HeldJoints::new(self.skeleton, self.planes, &bending);
         let rows = positions.iter().map(|&p| bend.row(p, &bending)).collect();
-        (PieceTreatment::Joints, rows)
+        UnitWeights {
+            treatment: PieceTreatment::Joints,
+            rows,
+            off_carrier: 0,
+        }
     }
 
-    /// The rows of a piece attached by its contact: each vertex takes the body row of the
-    /// contact vertex nearest to it along the piece's edges (a multi-source Dijkstra from
-    /// the contact), so the weights vary only where the piece lies on the body.
-    fn carried_from_contact(
-        &self,
-        vertices: &[u32],
-        contact: &[bool],
-        points: &[Option<BodyPoint>],
-    ) -> Vec<Row> {
+    /// The rows of a piece carried along its edges from its `sources`: each vertex takes
+    /// the row in `rows` of the source vertex nearest to it along the piece's edges (a
+    /// multi-source Dijkstra). From the contact, the weights of a piece attached by its
+    /// contact vary only where it lies on the body; from the rows that kept weight on the
+    /// piece's carrier ([`on_one_carrier`]), the others take their nearest such row.
+    fn carried_along(&self, vertices: &[u32], sources: &[bool], rows: &[Row]) -> Vec<Row> {
         let local: HashMap<u32, usize> =
             vertices.iter().enumerate().map(|(i, &v)| (v, i)).collect();
         let mut distance = vec![f64::INFINITY; vertices.len()];
         let mut source: Vec<usize> = (0..vertices.len()).collect();
         let mut heap = BinaryHeap::new();
-        for (i, _) in contact.iter().enumerate().filter(|(_, &c)| c) {
+        for (i, _) in sources.iter().enumerate().filter(|(_, &c)| c) {
             distance[i] = 0.0;
             heap.push(Nearest {
                 distance: 0.0,
@@ -512,15 +543,7 @@ impl LoosePiece<'_> {
                 }
             }
         }
-        source
-            .iter()
-            .map(|&s| {
-                points[s]
-                    .as_ref()
-                    .map(|at| at.row.clone())
-                    .unwrap_or_default()
-            })
-            .collect()
+        source.iter().map(|&s| rows[s].clone()).collect()
     }
 }
 

@@ -47,6 +47,9 @@ pub struct WeightCounts {
     pub bent: usize,
     /// Of those, vertices of pieces attached to the body surface they sit on.
     pub attached: usize,
+    /// Of the attached vertices, those whose body weights lay partly off the one part of
+    /// the skeleton that carries their piece ([`super::carriers`]) and were replaced.
+    pub off_carrier: usize,
     /// Of those, vertices of pieces bound rigidly to one joint.
     pub rigid: usize,
     /// Every piece (connected component of the split surface) and how it was weighted.

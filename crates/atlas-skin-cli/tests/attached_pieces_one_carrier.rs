@@ -1,0 +1,36 @@
+//! An attached piece moves with one part of the skeleton (`weights::carriers`), on real
+//! characters of the benchmark (`../shared/data/bench`):
+//! - rignet-val/3613, whose knee pads reach past the gap between the knees: the edge of
+//!   each pad took the other knee's weights from the body under it, and tore off when the
+//!   legs moved (deform max 0.205 of the diagonal against the artist's weights, 3.7 times
+//!   its better baseline's);
+//! - KayKit's Mage, whose wide hat brim reaches out over its hands in the bind pose: the
+//!   brim's ends moved with the wrists (deform max 0.339).
+
+mod support;
+
+/// Skins `input`; returns the report's count of rows moved onto their piece's carrier and
+/// the deform figures against the artist's weights.
+fn skin_and_deform(input: &str, stem: &str) -> (u64, serde_json::Value) {
+    let input = atlas_skin_corpus::data_dir().join(input);
+    let dir = support::out_dir("attached-pieces-one-carrier");
+    let (glb, report) = support::skin_with_report(&input, &dir, stem);
+    let off_carrier = report["counts"]["off_carrier_vertices"].as_u64().unwrap();
+    (off_carrier, support::deform_random(&input, &glb))
+}
+
+#[test]
+fn knee_pads_across_the_gap_between_the_knees_move_with_their_own_knee() {
+    let (off_carrier, deform) = skin_and_deform("bench/rignet-val/3613.glb", "3613");
+    assert!(off_carrier > 0, "no row moved onto its carrier");
+    // Measured 0.0027 / 0.073.
+    assert!(deform["max"].as_f64().unwrap() < 0.12, "{deform}");
+}
+
+#[test]
+fn a_hat_brim_over_the_hands_moves_with_the_head() {
+    let (off_carrier, deform) = skin_and_deform("bench/kaykit/Mage.glb", "mage");
+    assert!(off_carrier > 0, "no row moved onto its carrier");
+    // Measured 0.0063 / 0.190.
+    assert!(deform["max"].as_f64().unwrap() < 0.26, "{deform}");
+}
