@@ -4,7 +4,7 @@
 //! checked against the mesh ([`crate::skeleton::placement`]) and given a hierarchy when it
 //! has several roots ([`crate::skeleton::hierarchy`]) → decomposition (§3.1 cuts, §3.2 regions:
 //! [`crate::decompose()`]) → overlaps (§3.3: [`crate::overlap`]) → weights (§4, §5:
-//! [`crate::weights`], then the guard against far bones, [`crate::weights::guard`]) →
+//! [`crate::weights`], with the guard against far bones, [`crate::weights::guard`]) →
 //! un-weld (weights per stored vertex, pruned to `max_influences`).
 //! Settings are validated once, before any work; each stage's wall time is measured here.
 //!
@@ -23,7 +23,6 @@ use crate::skeleton::bones::{bone_segments, capped_extensions, nearest_bone, EXT
 use crate::skeleton::hierarchy::infer_hierarchy;
 use crate::skeleton::placement::{check_placement, decomposition_warnings, PlacementError};
 use crate::weights::blend::Blend;
-use crate::weights::guard::guard_far_bones;
 use crate::weights::{compute_weights, SurfaceWeights, WeightCounts, WeightsError};
 use atlas_skin_runtime::{RuntimeError, Skeleton, VertexWeights};
 use glam::{DVec3, Vec3};
@@ -253,10 +252,8 @@ pub fn skin(
     done(&mut timings);
 
     let done = run(Stage::Weights);
-    let (mut surface_weights, mut weight_counts) =
+    let (surface_weights, weight_counts) =
         compute_weights(&decomposition, &skeleton, &overlaps, params.blend)?;
-    weight_counts.far_bone_vertices =
-        guard_far_bones(&decomposition, &skeleton, &mut surface_weights);
     let weights = unweld_weights(
         &surface_weights,
         &welded.welded_of_stored,

@@ -1,4 +1,4 @@
-//! The part of the skeleton that carries an attached piece (step 4, rule 2 of
+//! The part of the skeleton that carries an attached piece (step 5, rule 2 of
 //! [`super::pieces`]).
 //!
 //! An attached piece takes the weights of the body surface nearest to each of its

@@ -1,4 +1,4 @@
-//! Step 5 of the weights: the guard against gross misassignment (issue 13). A region, a
+//! Step 4 of the weights: the guard against gross misassignment (issue 13). A region, a
 //! cut or a soft boundary can hand a vertex to a joint whose bones are far from it while
 //! nearer bones run through the body beside it (a forearm vertex bound to a finger joint
 //! whose plane crosses the forearm; a neck vertex bound to an ear). Such a weight moves

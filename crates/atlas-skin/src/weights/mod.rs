@@ -55,15 +55,18 @@
 //!    its patch ([`crate::weights::patches`]): with P = Σ_j p_j over the region's patches, every
 //!    joint of the region keeps its mass times 1 − min(1, P), and patch j receives
 //!    ω p_j / max(1, P).
-//! 4. **Pieces.** A piece of the surface (connected component) that no region with joints
+//! 4. **Guard.** A weight on a joint whose bones are far from the vertex, many times
+//!    farther than the nearest bone reached through the body, is removed and the row
+//!    renormalised ([`guard`]), on the weights of steps 1–3.
+//! 5. **Pieces.** A piece of the surface (connected component) that no region with joints
 //!    reaches is weighted as a whole by its geometry ([`crate::weights::pieces`]): attached
 //!    to the body surface it sits on (weights of the nearest body point, interpolated over
 //!    its face), rigid to one joint when it spans none, or bent at its joints by the
 //!    nearest bone. The vertices of a decomposed piece that no region reaches (its gaps)
-//!    are weighted as a whole by the same rules.
-//! 5. **Guard.** A weight on a joint whose bones are far from the vertex, many times
-//!    farther than the nearest bone reached through the body, is removed and the row
-//!    renormalised ([`guard`]); the pipeline runs it on the result of steps 1–4.
+//!    are weighted as a whole by the same rules. The guard does not touch them: its
+//!    correction, vertex by vertex, would tear a piece apart that these rules keep whole
+//!    (a rigid hood whose flared edge lies over the upper arm; docs/measurements.md, "The
+//!    guard against far bones").
 //!
 //! Inputs: a [`Decomposition`], the decomposed skeleton, its [`Overlaps`]
 //! ([`crate::overlap`]) and the [`Blend`]. Output: [`SurfaceWeights`], weights of every
@@ -86,6 +89,7 @@ use crate::overlap::Overlaps;
 use atlas_skin_runtime::Skeleton;
 use blend::Blend;
 use chains::{blend_vertices, region_trees};
+use guard::guard_far_bones;
 use patches::leaf_patches;
 use pieces::weight_pieces;
 use related::{region_vertices, related_regions, vertex_bands};
@@ -128,6 +132,36 @@ pub fn compute_weights(
     overlaps: &Overlaps,
     blend: Blend,
 ) -> Result<(SurfaceWeights, WeightCounts), WeightsError> {
+    let RegionWeights {
+        mut weights,
+        leaf_patches,
+        inactive_soft_joints,
+    } = region_weights(decomposition, skeleton, overlaps, blend)?;
+    let far_bone_vertices = guard_far_bones(decomposition, skeleton, &mut weights);
+    let mut counts = weight_pieces(decomposition, skeleton, overlaps, &mut weights);
+    counts.far_bone_vertices = far_bone_vertices;
+    counts.leaf_patches = leaf_patches;
+    counts.inactive_soft_joints = inactive_soft_joints;
+    Ok((weights, counts))
+}
+
+/// The weights of steps 1–3 (module documentation): of the vertices that regions with
+/// joints reach, the others left without weights.
+pub struct RegionWeights {
+    pub weights: SurfaceWeights,
+    /// Leaf joints that move a patch of skin (step 3b).
+    pub leaf_patches: Vec<u32>,
+    /// Joints whose soft boundary is inactive (no cross-section near the joint).
+    pub inactive_soft_joints: Vec<u32>,
+}
+
+/// Steps 1–3 alone (module documentation), with the arguments of [`compute_weights`].
+pub fn region_weights(
+    decomposition: &Decomposition,
+    skeleton: &Skeleton,
+    overlaps: &Overlaps,
+    blend: Blend,
+) -> Result<RegionWeights, WeightsError> {
     validate(decomposition, skeleton, overlaps)?;
     let vertex_count = decomposition.surface.vertex_count();
     let bands = vertex_bands(&overlaps.bands, vertex_count);
@@ -150,16 +184,17 @@ pub fn compute_weights(
         .collect();
     let patches = leaf_patches(decomposition, skeleton, &active, &region_vertices);
     let trees = region_trees(decomposition, skeleton, &softs);
-    let mut weights = blend_vertices(decomposition, &related, &softs, &patches, &trees, blend);
-    let mut counts = weight_pieces(decomposition, skeleton, overlaps, &mut weights);
-    counts.leaf_patches = patches.iter().map(|p| p.joint).collect();
-    counts.inactive_soft_joints = decomposition
-        .boundaries
-        .iter()
-        .filter(|b| b.kind == BoundaryKind::Soft && !has_soft_side[b.joint as usize])
-        .map(|b| b.joint)
-        .collect();
-    Ok((weights, counts))
+    let weights = blend_vertices(decomposition, &related, &softs, &patches, &trees, blend);
+    Ok(RegionWeights {
+        weights,
+        leaf_patches: patches.iter().map(|p| p.joint).collect(),
+        inactive_soft_joints: decomposition
+            .boundaries
+            .iter()
+            .filter(|b| b.kind == BoundaryKind::Soft && !has_soft_side[b.joint as usize])
+            .map(|b| b.joint)
+            .collect(),
+    })
 }
 
 /// The decomposition, the skeleton and the overlaps belong together: one decision per

@@ -1,4 +1,4 @@
-//! Step 4 of the weights: every piece of the surface weighted on purpose.
+//! Step 5 of the weights: every piece of the surface weighted on purpose.
 //!
 //! A piece is a connected component of the split surface (faces joined across edges,
 //! cut curves included). After steps 1–3 a piece either holds regions with joints (a bone
@@ -96,7 +96,7 @@ use rayon::prelude::*;
 use std::collections::{BinaryHeap, HashMap};
 use std::sync::OnceLock;
 
-/// Step 4: weights every vertex steps 1–3 left without weights, piece by piece (module
+/// Step 5: weights every vertex steps 1–3 left without weights, piece by piece (module
 /// documentation); returns the counts and how each piece was weighted.
 pub fn weight_pieces(
     decomposition: &Decomposition,

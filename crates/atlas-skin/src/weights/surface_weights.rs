@@ -60,7 +60,7 @@ pub struct WeightCounts {
     pub inactive_soft_joints: Vec<u32>,
     /// Leaf joints that move a patch of skin (step 3b).
     pub leaf_patches: Vec<u32>,
-    /// Vertices whose weights on far joints the guard removed (step 5).
+    /// Vertices whose weights on far joints the guard removed (step 4).
     pub far_bone_vertices: usize,
 }
 
