@@ -274,17 +274,14 @@ impl SectionDomain {
         // The crossed faces first (a read-only scan, the hot loop), then the tracing.
         let mut crossed = std::mem::take(&mut self.crossed_faces);
         crossed.clear();
-        let side = &self.local_side;
-        crossed.extend(
-            self.local_faces
-                .iter()
-                .enumerate()
-                .filter(|(_, &[a, b, c])| {
-                    // 1 or 2 corners on the positive side.
-                    (side[a as usize] + side[b as usize] + side[c as usize]).wrapping_sub(1) < 2
-                })
-                .map(|(i, _)| i as u32),
-        );
+        // A slice, not the vector, so that its start and length stay in registers.
+        let side: &[u8] = &self.local_side;
+        for (i, &[a, b, c]) in self.local_faces.iter().enumerate() {
+            // 1 or 2 corners on the positive side.
+            if (side[a as usize] + side[b as usize] + side[c as usize]).wrapping_sub(1) < 2 {
+                crossed.push(i as u32);
+            }
+        }
         let mut curves = Vec::new();
         for &i in &crossed {
             for e in self.local_face_edges[i as usize] {
