@@ -83,7 +83,7 @@ use super::surface_weights::{SurfaceWeights, WeightCounts};
 use crate::decomposition::Decomposition;
 use crate::mesh::edge_distance::Nearest;
 use crate::mesh::topology::Topology;
-use crate::mesh::winding::faces_winding_number;
+use crate::mesh::winding::faces_inside;
 use crate::mesh::{FaceSpheres, SurfaceMesh};
 use crate::overlap::Overlaps;
 use crate::skeleton::bones::{bone_segments, nearest_bone_with_distance, NearestBone};
@@ -605,9 +605,7 @@ fn held_bones_counting(
         .collect();
     let (lo, hi) = crate::geometry::bounding_box(&positions);
     let inside = |q: DVec3| {
-        q.cmpge(lo).all()
-            && q.cmple(hi).all()
-            && faces_winding_number(&surface.positions, faces, q).abs() > 0.5
+        q.cmpge(lo).all() && q.cmple(hi).all() && faces_inside(&surface.positions, faces, q)
     };
     let inside_counts: Vec<((u32, DVec3, DVec3), usize)> = segments
         .iter()
@@ -770,7 +768,7 @@ fn most_frequent(joints: &[Option<u32>]) -> Option<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fixtures::shapes::icosphere;
+    use crate::fixtures::shapes::{faces_above, icosphere};
 
     #[test]
     fn a_piece_that_holds_a_chain_bends_at_its_joints_planes() {
@@ -841,18 +839,9 @@ mod tests {
         assert_eq!(held.iter().map(|s| s.0).collect::<Vec<_>>(), vec![0]);
         let held = held_bones(&ball, &vertices, &ball.triangles, &with_tip[1..]);
         assert_eq!(held.iter().map(|s| s.0).collect::<Vec<_>>(), vec![3]);
-        let cap = cap_above(&ball, 0.8);
+        let cap = faces_above(&ball, 0.8);
         assert!(!cap.is_empty());
         assert!(held_bones(&ball, &vertices, &cap, &segments).is_empty());
-    }
-
-    /// The faces of `ball` with every corner above `y`.
-    fn cap_above(ball: &SurfaceMesh, y: f64) -> Vec<[u32; 3]> {
-        ball.triangles
-            .iter()
-            .filter(|t| t.iter().all(|&v| ball.positions[v as usize].y > y))
-            .copied()
-            .collect()
     }
 
     /// Every point tested: the reference for [`samples_inside`].
@@ -869,7 +858,7 @@ mod tests {
     fn held_bones_stop_counting_where_the_answer_is_known() {
         let ball = icosphere(1.0, 3);
         let vertices: Vec<u32> = (0..ball.positions.len() as u32).collect();
-        let cap = cap_above(&ball, 0.3);
+        let cap = faces_above(&ball, 0.3);
         let mut rng = atlas_skin_runtime::random_pose::SplitMix64::new(17);
         let mut point = || DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64()) * 3.0 - 1.5;
         let mut held_some = 0;
