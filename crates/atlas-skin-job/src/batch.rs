@@ -270,6 +270,8 @@ pub fn plan_jobs(inputs: &[PathBuf], options: &BatchOptions) -> Result<Vec<SkinJ
                 html: options.html.then(|| output("html")),
                 ..Outputs::glb(glb)
             },
+            // The log's timings, counts and warnings come from the report.
+            keep_report: true,
         });
     }
     Ok(jobs)
@@ -335,7 +337,7 @@ fn run_one(job: &SkinJob, resume: bool, stop: &AtomicBool) -> Record {
     }
     match job.run(&mut |_| {}) {
         Ok(outcome) => {
-            let mut report = outcome.report;
+            let mut report = outcome.report.unwrap_or_default();
             record.status = Status::Ok;
             record.timings_ms = Some(report["timings_ms"].take());
             record.counts = Some(report["counts"].take());

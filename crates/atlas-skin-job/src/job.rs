@@ -154,13 +154,18 @@ pub struct SkinJob {
     pub input: Input,
     pub settings: Settings,
     pub outputs: Outputs,
+    /// Return the JSON report in the [`JobOutcome`] even when no output needs it (a
+    /// batch's log, the Python binding); without it the report is built only for
+    /// [`Outputs::report`] and [`Outputs::html`].
+    pub keep_report: bool,
 }
 
 /// What a finished job tells its caller.
 #[derive(Debug, Clone)]
 pub struct JobOutcome {
-    /// The JSON report (also written when [`Outputs::report`] is given).
-    pub report: Value,
+    /// The JSON report, when [`SkinJob::keep_report`] asked for it or an output needed it
+    /// (written when [`Outputs::report`] is given).
+    pub report: Option<Value>,
     /// What the method noticed and handled (the report's warnings also hold the reader's).
     pub method_warnings: Vec<String>,
     /// One line: input, vertices, joints (cut, soft, skipped), regions, output.
@@ -212,12 +217,16 @@ impl SkinJob {
         timings.insert("write".into(), json!(start.elapsed().as_secs_f64() * 1e3));
 
         let input_name = character.path.display().to_string();
-        let mut report = skin_report(&input_name, &character.warnings, &skinned, timings);
-        if let Some(source) = &character.gltf {
-            report["vertex_ranges"] = vertex_ranges(source);
-        }
-        if let Some(path) = &outputs.report {
-            let text = serde_json::to_string_pretty(&report).map_err(JobError::Report)?;
+        let wanted = self.keep_report || outputs.report.is_some() || outputs.html.is_some();
+        let report = wanted.then(|| {
+            let mut report = skin_report(&input_name, &character.warnings, &skinned, timings);
+            if let Some(source) = &character.gltf {
+                report["vertex_ranges"] = vertex_ranges(source);
+            }
+            report
+        });
+        if let (Some(path), Some(report)) = (&outputs.report, &report) {
+            let text = serde_json::to_string_pretty(report).map_err(JobError::Report)?;
             plan.write(path, text.as_bytes())?;
         }
         if let Some(path) = &outputs.rig_info {
@@ -233,7 +242,7 @@ impl SkinJob {
             plan.write(path, &bytes)?;
         }
         if let Some(path) = &outputs.html {
-            write_html(&glb, Some(&report), path, &plan)?;
+            write_html(&glb, report.as_ref(), path, &plan)?;
         }
         let d = skinned.decomposition.report();
         let summary = format!(
@@ -271,4 +280,45 @@ fn debug_view(skinned: &Skinned, path: &Path) -> Result<Vec<u8>, IoError> {
         [0.0, 0.0, 0.0, 1.0],
         path,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The report is built for the outcome only when asked (`keep_report`) or when an
+    /// output needs it; the glb is the same either way.
+    #[test]
+    fn the_report_is_built_when_asked_or_written() {
+        let input = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../../shared/data/models/riggedsimple/RiggedSimple.glb"
+        );
+        let dir =
+            std::env::temp_dir().join(format!("atlas-skin-job-report-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let run = |name: &str, keep_report: bool, report: bool| {
+            let glb = dir.join(format!("{name}.glb"));
+            let job = SkinJob {
+                input: Input::file(input),
+                outputs: Outputs {
+                    report: report.then(|| dir.join(format!("{name}.json"))),
+                    ..Outputs::glb(&glb)
+                },
+                keep_report,
+                ..SkinJob::default()
+            };
+            let outcome = job.run(&mut |_| {}).unwrap();
+            (outcome.report, std::fs::read(glb).unwrap())
+        };
+        let (none, glb) = run("plain", false, false);
+        let (kept, kept_glb) = run("kept", true, false);
+        let (written, _) = run("written", false, true);
+        std::fs::remove_dir_all(&dir).unwrap();
+        assert!(none.is_none());
+        assert_eq!(glb, kept_glb);
+        let kept = kept.expect("kept");
+        assert!(kept["counts"]["vertices"].as_u64().is_some_and(|n| n > 0));
+        assert_eq!(written.expect("written")["counts"], kept["counts"]);
+    }
 }

@@ -356,9 +356,10 @@ fn skin_file<'py>(
             debug_glb,
             rig_info,
         },
+        keep_report: true,
     };
     let outcome = py.detach(|| no_panic(|| job.run(&mut |_| {}).map_err(|e| to_py_err(&e))))?;
-    json_object(py, &outcome.report)
+    json_object(py, &outcome.report.unwrap_or_default())
 }
 
 #[allow(clippy::too_many_arguments)]

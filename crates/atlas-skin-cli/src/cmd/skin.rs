@@ -121,6 +121,7 @@ pub fn run(args: Args) -> Result<()> {
             debug_glb: args.debug_glb,
             rig_info: args.rig_info,
         },
+        keep_report: false,
     };
     let progress = progress_bar();
     let outcome = job.run(&mut |step| progress.set_message(step));

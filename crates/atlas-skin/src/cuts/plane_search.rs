@@ -187,6 +187,7 @@ fn search_within(
         position: frame.position,
         domain: SectionDomain::new(mesh, topology, surface.vertex_snap, faces, scratch),
         basis: NormalBasis::new(frame.upper, frame.lower),
+        evaluated: Vec::new(),
     };
     let step = params.angle_step_deg.to_radians();
     let mut found: Vec<(f64, f64, CutCandidate)> = search
@@ -333,15 +334,36 @@ struct PlaneSearch<'a> {
     position: DVec3,
     domain: SectionDomain,
     basis: NormalBasis,
+    /// Every plane evaluated, by the bits of its normal: its outcome and how many sections
+    /// it turned down for enclosing another bone.
+    evaluated: Vec<([u64; 3], Option<CutCandidate>, usize)>,
 }
 
 impl PlaneSearch<'_> {
     /// The shortest closed section of P(J, n(α, β)) around J that no other bone passes
-    /// through.
+    /// through. The pattern search comes back to planes it has evaluated (a move from α to
+    /// α + h tries α + h − h, which is often α to the bit): a plane's outcome depends on
+    /// its normal alone (the point is J), so an evaluated normal's outcome is reused, its
+    /// turned-down sections counted again as a new evaluation would.
     fn evaluate(&mut self, alpha: f64, beta: f64) -> Option<CutCandidate> {
+        let normal = self.basis.normal(alpha, beta);
+        let key = [normal.x.to_bits(), normal.y.to_bits(), normal.z.to_bits()];
+        if let Some((_, best, enclosing)) = self.evaluated.iter().find(|e| e.0 == key) {
+            self.enclosing_other_bones += enclosing;
+            return best.clone();
+        }
+        let before = self.enclosing_other_bones;
+        let best = self.shortest_section(normal);
+        let enclosing = self.enclosing_other_bones - before;
+        self.evaluated.push((key, best.clone(), enclosing));
+        best
+    }
+
+    /// [`Self::evaluate`] of the plane through J with unit `normal`, computed.
+    fn shortest_section(&mut self, normal: DVec3) -> Option<CutCandidate> {
         let plane = Plane {
             point: self.position,
-            normal: self.basis.normal(alpha, beta),
+            normal,
         };
         let mut best: Option<CutCandidate> = None;
         for curve in self.domain.closed_sections(&plane) {
@@ -390,5 +412,54 @@ mod tests {
         }
         assert!(NormalBasis::new(upper, DVec3::Y).cone);
         assert!(!NormalBasis::new(upper, DVec3::new(0.8, 0.6, 0.0)).cone);
+    }
+
+    /// A plane evaluated again gives what it gave, and counts its turned-down sections
+    /// again, as computing it anew does: a bent tube, with and without another bone through
+    /// the joint's sections, the coarse samples and moves of ±h from them, each twice.
+    #[test]
+    fn a_plane_evaluated_again_gives_what_computing_it_gives() {
+        use crate::cuts::plane_section::vertex_snap_distances;
+        use crate::fixtures::shapes::bent_cylinder;
+        let (mesh, _) = bent_cylinder(0.2, 1.0, 60.0, 16, 8);
+        let topology = Topology::new(&mesh);
+        let snap = vertex_snap_distances(&mesh, &topology, 0.01);
+        let joint = DVec3::Y;
+        let through = [[
+            joint + 0.05 * DVec3::X - 0.1 * DVec3::Y,
+            joint + 0.05 * DVec3::X + 0.1 * DVec3::Y,
+        ]];
+        let faces: Vec<u32> = (0..mesh.triangle_count() as u32).collect();
+        let mut scratch = DomainScratch::default();
+        for other_bones in [&[][..], &through[..]] {
+            let mut new_search = || PlaneSearch {
+                mesh: &mesh,
+                topology: &topology,
+                other_bones,
+                enclosing_other_bones: 0,
+                position: joint,
+                domain: SectionDomain::new(&mesh, &topology, &snap, faces.clone(), &mut scratch),
+                basis: NormalBasis::new(DVec3::Y, DVec3::new(0.6f64.sin(), 0.6f64.cos(), 0.0)),
+                evaluated: Vec::new(),
+            };
+            let (mut reused, mut computed) = (new_search(), new_search());
+            let h = 5f64.to_radians();
+            let samples = reused.basis.coarse_samples(2.0 * h, 30f64.to_radians());
+            let mut found = 0;
+            for (alpha, beta) in samples
+                .iter()
+                .flat_map(|&(a, b)| [(a, b), (a + h, b), (a + h - h, b)])
+            {
+                for _ in 0..2 {
+                    let expected = computed.shortest_section(computed.basis.normal(alpha, beta));
+                    found += usize::from(expected.is_some());
+                    assert_eq!(reused.evaluate(alpha, beta), expected);
+                    assert_eq!(reused.enclosing_other_bones, computed.enclosing_other_bones);
+                }
+            }
+            assert!(found > 0);
+            assert_eq!(computed.enclosing_other_bones > 0, !other_bones.is_empty());
+            assert!(reused.evaluated.len() < 3 * samples.len());
+        }
     }
 }

@@ -188,26 +188,38 @@ impl SectionDomain {
         for (i, &f) in faces.iter().enumerate() {
             local_face_of[f as usize] = i as u32 + 1;
         }
-        let local_faces: Vec<[u32; 3]> = faces
-            .iter()
-            .map(|&f| mesh.triangles[f as usize].map(|v| local(local_vertex_of, &mut vertices, v)))
-            .collect();
-        let local_face_edges: Vec<[u32; 3]> = faces
-            .iter()
-            .map(|&f| topology.face_edges[f as usize].map(|e| local(local_edge_of, &mut edges, e)))
-            .collect();
-        let edge_ends = edges
-            .iter()
-            .map(|&e| topology.edges[e as usize].map(|v| local_vertex_of[v as usize] - 1))
-            .collect();
+        // Corners and edges read one by one: `array::map` is not inlined here, and these
+        // loops are most of a domain's cost.
+        let mut local_faces = Vec::with_capacity(faces.len());
+        let mut local_face_edges = Vec::with_capacity(faces.len());
+        for &f in &faces {
+            let [a, b, c] = mesh.triangles[f as usize];
+            local_faces.push([
+                local(local_vertex_of, &mut vertices, a),
+                local(local_vertex_of, &mut vertices, b),
+                local(local_vertex_of, &mut vertices, c),
+            ]);
+            let [d, e, g] = topology.face_edges[f as usize];
+            local_face_edges.push([
+                local(local_edge_of, &mut edges, d),
+                local(local_edge_of, &mut edges, e),
+                local(local_edge_of, &mut edges, g),
+            ]);
+        }
         let in_domain = |f: u32| local_face_of[f as usize].checked_sub(1);
-        let edge_faces = edges
-            .iter()
-            .map(|&e| match topology.faces_of_edge(e as usize) {
-                &[f, g] => Some([in_domain(f)?, in_domain(g)?]),
+        let mut edge_ends = Vec::with_capacity(edges.len());
+        let mut edge_faces = Vec::with_capacity(edges.len());
+        for &e in &edges {
+            let [a, b] = topology.edges[e as usize];
+            edge_ends.push([
+                local_vertex_of[a as usize] - 1,
+                local_vertex_of[b as usize] - 1,
+            ]);
+            edge_faces.push(match topology.faces_of_edge(e as usize) {
+                &[f, g] => in_domain(f).zip(in_domain(g)).map(|(f, g)| [f, g]),
                 _ => None,
-            })
-            .collect();
+            });
+        }
         for &v in &vertices {
             local_vertex_of[v as usize] = 0;
         }
@@ -262,17 +274,14 @@ impl SectionDomain {
         // The crossed faces first (a read-only scan, the hot loop), then the tracing.
         let mut crossed = std::mem::take(&mut self.crossed_faces);
         crossed.clear();
-        let side = &self.local_side;
-        crossed.extend(
-            self.local_faces
-                .iter()
-                .enumerate()
-                .filter(|(_, &[a, b, c])| {
-                    // 1 or 2 corners on the positive side.
-                    (side[a as usize] + side[b as usize] + side[c as usize]).wrapping_sub(1) < 2
-                })
-                .map(|(i, _)| i as u32),
-        );
+        // A slice, not the vector, so that its start and length stay in registers.
+        let side: &[u8] = &self.local_side;
+        for (i, &[a, b, c]) in self.local_faces.iter().enumerate() {
+            // 1 or 2 corners on the positive side.
+            if (side[a as usize] + side[b as usize] + side[c as usize]).wrapping_sub(1) < 2 {
+                crossed.push(i as u32);
+            }
+        }
         let mut curves = Vec::new();
         for &i in &crossed {
             for e in self.local_face_edges[i as usize] {

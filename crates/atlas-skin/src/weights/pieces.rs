@@ -86,7 +86,7 @@ use super::surface_weights::{SurfaceWeights, WeightCounts};
 use crate::decomposition::Decomposition;
 use crate::mesh::edge_distance::Nearest;
 use crate::mesh::topology::Topology;
-use crate::mesh::winding::faces_winding_number;
+use crate::mesh::winding::faces_inside;
 use crate::mesh::{FaceSpheres, SurfaceMesh};
 use crate::overlap::Overlaps;
 use crate::skeleton::bones::{bone_segments, nearest_bone_with_distance, NearestBone};
@@ -606,27 +606,39 @@ fn held_bones(
     faces: &[[u32; 3]],
     segments: &[(u32, DVec3, DVec3)],
 ) -> Vec<(u32, DVec3, DVec3)> {
+    held_bones_counting(surface, vertices, faces, segments, samples_inside)
+}
+
+/// ⌈n/2⌉ of the [`BONE_SAMPLES`]: a segment with this many points inside is held mostly.
+const MOSTLY_INSIDE: usize = BONE_SAMPLES.div_ceil(2);
+
+/// [`held_bones`], with `count(a, b, inside)` the number of points of the segment a–b
+/// inside (as far as [`held_bones`] reads it: 0, 1 to [`MOSTLY_INSIDE`] − 1, or at least
+/// [`MOSTLY_INSIDE`]).
+fn held_bones_counting(
+    surface: &SurfaceMesh,
+    vertices: &[u32],
+    faces: &[[u32; 3]],
+    segments: &[(u32, DVec3, DVec3)],
+    count: fn(DVec3, DVec3, &dyn Fn(DVec3) -> bool) -> usize,
+) -> Vec<(u32, DVec3, DVec3)> {
     let positions: Vec<DVec3> = vertices
         .iter()
         .map(|&v| surface.positions[v as usize])
         .collect();
     let (lo, hi) = crate::geometry::bounding_box(&positions);
-    let inside = |q: DVec3| faces_winding_number(&surface.positions, faces, q).abs() > 0.5;
+    let inside = |q: DVec3| {
+        q.cmpge(lo).all() && q.cmple(hi).all() && faces_inside(&surface.positions, faces, q)
+    };
     let inside_counts: Vec<((u32, DVec3, DVec3), usize)> = segments
         .iter()
         .filter(|&&(_, a, b)| a.min(b).cmple(hi).all() && a.max(b).cmpge(lo).all())
-        .map(|&(j, a, b)| {
-            let count = (0..BONE_SAMPLES)
-                .map(|k| a + (b - a) * ((k as f64 + 0.5) / BONE_SAMPLES as f64))
-                .filter(|&q| q.cmpge(lo).all() && q.cmple(hi).all() && inside(q))
-                .count();
-            ((j, a, b), count)
-        })
+        .map(|&(j, a, b)| ((j, a, b), count(a, b, &inside)))
         .filter(|&(_, count)| count > 0)
         .collect();
-    let mostly = |count: usize| 2 * count >= BONE_SAMPLES;
+    let mostly = |count: usize| count >= MOSTLY_INSIDE;
     let least = if inside_counts.iter().any(|&(_, count)| mostly(count)) {
-        BONE_SAMPLES.div_ceil(2)
+        MOSTLY_INSIDE
     } else {
         1
     };
@@ -635,6 +647,28 @@ fn held_bones(
         .filter(|&(_, count)| count >= least)
         .map(|(segment, _)| segment)
         .collect()
+}
+
+/// The k-th of the [`BONE_SAMPLES`] points of the segment a–b: a + (k + ½)/n · (b − a).
+fn bone_sample(a: DVec3, b: DVec3, k: usize) -> DVec3 {
+    a + (b - a) * ((k as f64 + 0.5) / BONE_SAMPLES as f64)
+}
+
+/// The points of the segment a–b `inside`, counted only as far as [`held_bones`] reads the
+/// count: whether some are inside and whether [`MOSTLY_INSIDE`] are. The count stops at
+/// [`MOSTLY_INSIDE`], or once some are inside and the points left cannot make
+/// [`MOSTLY_INSIDE`] (each point's winding number is a sum over the piece's faces: on a
+/// piece that holds a bone, half of them are skipped).
+fn samples_inside(a: DVec3, b: DVec3, inside: &dyn Fn(DVec3) -> bool) -> usize {
+    let mut count = 0;
+    for k in 0..BONE_SAMPLES {
+        let left = BONE_SAMPLES - k;
+        if count >= MOSTLY_INSIDE || (count > 0 && count + left < MOSTLY_INSIDE) {
+            break;
+        }
+        count += usize::from(inside(bone_sample(a, b, k)));
+    }
+    count
 }
 
 /// The joints whose bones a piece holds, as a forest (each under its nearest held
@@ -757,7 +791,7 @@ fn most_frequent(joints: &[Option<u32>]) -> Option<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fixtures::shapes::icosphere;
+    use crate::fixtures::shapes::{faces_above, icosphere};
 
     #[test]
     fn a_piece_that_holds_a_chain_bends_at_its_joints_planes() {
@@ -828,14 +862,42 @@ mod tests {
         assert_eq!(held.iter().map(|s| s.0).collect::<Vec<_>>(), vec![0]);
         let held = held_bones(&ball, &vertices, &ball.triangles, &with_tip[1..]);
         assert_eq!(held.iter().map(|s| s.0).collect::<Vec<_>>(), vec![3]);
-        let cap: Vec<[u32; 3]> = ball
-            .triangles
-            .iter()
-            .filter(|t| t.iter().all(|&v| ball.positions[v as usize].y > 0.8))
-            .copied()
-            .collect();
+        let cap = faces_above(&ball, 0.8);
         assert!(!cap.is_empty());
         assert!(held_bones(&ball, &vertices, &cap, &segments).is_empty());
+    }
+
+    /// Every point tested: the reference for [`samples_inside`].
+    fn every_sample_inside(a: DVec3, b: DVec3, inside: &dyn Fn(DVec3) -> bool) -> usize {
+        (0..BONE_SAMPLES)
+            .filter(|&k| inside(bone_sample(a, b, k)))
+            .count()
+    }
+
+    /// The count that stops early holds the same segments as counting every point: random
+    /// segments in, out of and across a closed ball and an open cap of it, every length of
+    /// run inside.
+    #[test]
+    fn held_bones_stop_counting_where_the_answer_is_known() {
+        let ball = icosphere(1.0, 3);
+        let vertices: Vec<u32> = (0..ball.positions.len() as u32).collect();
+        let cap = faces_above(&ball, 0.3);
+        let mut rng = atlas_skin_runtime::random_pose::SplitMix64::new(17);
+        let mut point = || DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64()) * 3.0 - 1.5;
+        let mut held_some = 0;
+        for trial in 0..200 {
+            let segments: Vec<(u32, DVec3, DVec3)> = (0..1 + trial % 4)
+                .map(|j| (j as u32, point(), point()))
+                .collect();
+            for faces in [&ball.triangles, &cap] {
+                let held = held_bones(&ball, &vertices, faces, &segments);
+                let reference =
+                    held_bones_counting(&ball, &vertices, faces, &segments, every_sample_inside);
+                assert_eq!(held, reference);
+                held_some += usize::from(!held.is_empty());
+            }
+        }
+        assert!(held_some > 50, "{held_some}");
     }
 
     #[test]
