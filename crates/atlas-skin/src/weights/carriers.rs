@@ -40,17 +40,18 @@ pub fn on_one_carrier(skeleton: &Skeleton, rows: &[Row]) -> Option<(Vec<Row>, Ve
             carries[j as usize] = true;
         }
     }
-    // The part of a carrying joint: its topmost ancestor reached through carrying joints.
-    let part = |mut j: usize| {
-        while let Some(p) = skeleton.parent(j).filter(|&p| carries[p]) {
-            j = p;
+    // The part of each carrying joint: its topmost ancestor reached through carrying
+    // joints (parents first, so a parent's part is known before its children's).
+    let mut part: Vec<Option<usize>> = vec![None; skeleton.len()];
+    for j in skeleton.topological_order() {
+        if carries[j] {
+            part[j] = Some(skeleton.parent(j).and_then(|p| part[p]).unwrap_or(j));
         }
-        j
-    };
+    }
     let mut mass = vec![0.0; skeleton.len()];
     for &(j, w) in rows.iter().flatten() {
-        if carries[j as usize] {
-            mass[part(j as usize)] += w;
+        if let Some(top) = part[j as usize] {
+            mass[top] += w;
         }
     }
     let mut parts = (0..skeleton.len()).filter(|&j| mass[j] > 0.0);
@@ -59,7 +60,7 @@ pub fn on_one_carrier(skeleton: &Skeleton, rows: &[Row]) -> Option<(Vec<Row>, Ve
     let kept = (0..skeleton.len())
         .filter(|&j| mass[j] > 0.0)
         .fold(first, |best, j| if mass[j] > mass[best] { j } else { best });
-    let on_kept = |j: u32| carries[j as usize] && part(j as usize) == kept;
+    let on_kept = |j: u32| part[j as usize] == Some(kept);
     let mut keeps = Vec::with_capacity(rows.len());
     let rows = rows
         .iter()
