@@ -224,7 +224,8 @@ pub fn weight_pieces(
         }
         current = with_rows(weights, &rows);
     }
-    *weights = with_rows(weights, &rows);
+    // `current` is `weights` with every row of `rows` (with none when no pass ran: a copy).
+    *weights = current;
     counts.pieces = pieces;
     counts
 }
