@@ -17,9 +17,9 @@
 //! from the contact). A piece carried by one connected part (a vest over the chest and both
 //! shoulders, joined through the spine) is unchanged.
 //!
-//! Measured on the 64 scored bench characters (docs/pieces.md, "One carrier per attached
-//! piece"): τ from 0.05 to 0.5 all lower the average deform max (.1545 → .1460–.1477) and
-//! turn 8–9 characters better on the mean against 1–3 worse.
+//! Measured on the 65 bench characters, averages over the 65 (docs/pieces.md, "One
+//! carrier per attached piece"): τ from 0.05 to 0.5 all lower the average deform max
+//! (.1545 → .1460–.1477) and turn 8–9 characters better on the mean against 1–3 worse.
 
 use atlas_skin_runtime::Skeleton;
 
