@@ -21,12 +21,15 @@
 //!    part: with a(p) the distance from p to the nearest of the joint's own bones (its child
 //!    bones and every bone below them) and b(p) to the nearest other bone of the region
 //!    (bones of joints whose bone lies in it, except the joint's own upper bone, which meets
-//!    its child bones at the joint), κ_c(p) = β(clamp(1 − (a − b) / w_c, 0, 1)), and 1 when
-//!    the region has no other bone. It is 1 wherever the own bones are the nearer and falls
-//!    to 0 within one half-width past the surface equidistant from both, as a cut's weight
-//!    falls within its overlap band: a plane whose child side holds a sibling's part (a
-//!    jaw's, the front of the neck) leaves that part to the bones that run inside it.
-//!    π_c, the same formula with the bones of c's descendants that have no boundary of
+//!    its child bones at the joint), κ_c(p) = β(clamp(1 − (a − λ b) / w_c, 0, 1)), and 1
+//!    when the region has no other bone, with λ = 0.7 for a joint with child bones and 1
+//!    for a leaf (whose bone is a guess). It is 1 wherever the own bones are clearly the
+//!    nearer (a ≤ λ b) and falls to 0 within one half-width past that surface, as a cut's
+//!    weight falls within its overlap band: a plane whose child side holds a sibling's part
+//!    (a jaw's, the front of the neck) leaves that part to the bones that run inside it,
+//!    and a clavicle leaves the chest, about as near to the spine as to the clavicle, to
+//!    the spine.
+//!    π_c, the same formula (λ = 1) with the bones of c's descendants that have no boundary of
 //!    their own as own bones and c's child bones plus the region's other bones as others,
 //!    carries c's part past its plane where such a bone is the nearest: a chin that hangs
 //!    below the plane of the head joint but lies on the jaw bone moves with the head.

@@ -4,9 +4,19 @@
 //! With a(p) the distance from p to the nearest of the joint's own bones (its child bones
 //! and every bone below them) and b(p) to the nearest other bone of the region (bones of
 //! joints whose bone lies in it, except the joint's own upper bone, which meets its child
-//! bones at the joint), κ(p) = β(clamp(1 − (a − b) / w, 0, 1)), and 1 when the region has
-//! no other bone: 1 wherever the own bones are the nearer, falling to 0 within one
-//! half-width w past the surface equidistant from both.
+//! bones at the joint), κ(p) = β(clamp(1 − (a − λ b) / w, 0, 1)), and 1 when the region
+//! has no other bone: 1 wherever the own bones are clearly the nearer, a ≤ λ b, falling to
+//! 0 within one half-width w past that surface. λ = [`OWN_BONE_RATIO`] for a joint with
+//! child bones; 1 for a leaf, whose own bone is a guess (half its parent's), and for the
+//! `beyond` factor.
+//!
+//! Why λ < 1: near a soft joint the artists' weight follows the bones that are clearly
+//! nearer, not the surface equidistant from two bones. Over the soft joints with child
+//! bones of the 65 bench characters, the artist's weight on the joint averages .50–.55
+//! where a/b < 0.8 and drops to .25–.30 where 0.8 ≤ a/b < 1.2 (b there over every bone
+//! outside the joint's subtree; at clavicles and shoulders .27 → .07 → .02 for a/b in
+//! 0.5–0.8, 0.8–1, 1–1.2), while λ = 1 gave the joint .47 where 0.8 ≤ a/b < 1. Measured on
+//! the whole benchmark, docs/measurements.md ("Own bones clearly nearer").
 //!
 //! The bones are indexed once for every joint (`OwnershipBones`): the joints numbered in
 //! depth-first order, so that the bones of a joint's subtree are one range of numbers, in
@@ -21,6 +31,11 @@ use crate::weights::blend::beta;
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
 use std::collections::HashMap;
+
+/// λ: a joint with child bones keeps a vertex only where its own bones are at most this
+/// fraction of the distance to the region's other bones (module documentation; 0.6–0.8
+/// measure alike on the benchmark, 0.5 and 1 worse: docs/measurements.md).
+pub const OWN_BONE_RATIO: f64 = 0.7;
 
 /// The bones of a skeleton, indexed for the κ of any joint and region.
 pub(crate) struct OwnershipBones {
@@ -163,13 +178,15 @@ pub(crate) struct Ownership<'a> {
     /// [`Ownership::beyond`] the joint's child bones.
     other: [BoneSet<'a>; 2],
     half_width: f64,
+    /// λ of the module documentation.
+    ratio: f64,
 }
 
 impl<'a> Ownership<'a> {
     /// The bones κ compares for `joint` in `region`: its own bones, those of the joint and
     /// the joints below it, and the other bones of the region, those of every other joint
     /// whose decision lies in the region except the parent's bones ending at the joint's
-    /// position (its upper bone).
+    /// position (its upper bone); λ = [`OWN_BONE_RATIO`] when the joint has child joints.
     pub(crate) fn new(
         bones: &'a OwnershipBones,
         joint: usize,
@@ -194,6 +211,11 @@ impl<'a> Ownership<'a> {
                 BoneSet::NONE,
             ],
             half_width,
+            ratio: if below.1 - below.0 > 1 {
+                OWN_BONE_RATIO
+            } else {
+                1.0
+            },
         }
     }
 
@@ -222,10 +244,11 @@ impl<'a> Ownership<'a> {
                 },
             ],
             half_width: self.half_width,
+            ratio: 1.0,
         }
     }
 
-    /// κ(p) = β(clamp(1 − (a − b) / w, 0, 1)), a and b the distances from p to the
+    /// κ(p) = β(clamp(1 − (a − λ b) / w, 0, 1)), a and b the distances from p to the
     /// nearest own and other bone (1 without other bones, 0 without own bones).
     pub(crate) fn at(&self, position: DVec3) -> f64 {
         let own = self.own.nearest_distance(position);
@@ -241,7 +264,7 @@ impl<'a> Ownership<'a> {
             return 1.0;
         }
         let w = self.half_width.max(f64::MIN_POSITIVE);
-        beta((1.0 - (own - other) / w).clamp(0.0, 1.0))
+        beta((1.0 - (own - self.ratio * other) / w).clamp(0.0, 1.0))
     }
 }
 
@@ -309,7 +332,13 @@ mod tests {
     }
 
     /// κ by the formula with plain point–segment distances, every bone scanned.
-    fn reference_kappa(own: &[[DVec3; 2]], other: &[[DVec3; 2]], w: f64, p: DVec3) -> f64 {
+    fn reference_kappa(
+        own: &[[DVec3; 2]],
+        other: &[[DVec3; 2]],
+        ratio: f64,
+        w: f64,
+        p: DVec3,
+    ) -> f64 {
         let nearest = |bones: &[[DVec3; 2]]| {
             bones
                 .iter()
@@ -322,7 +351,7 @@ mod tests {
         } else if b == f64::INFINITY {
             1.0
         } else {
-            beta((1.0 - (a - b) / w).clamp(0.0, 1.0))
+            beta((1.0 - (a - ratio * b) / w).clamp(0.0, 1.0))
         }
     }
 
@@ -360,6 +389,55 @@ mod tests {
             &positions,
         )
         .unwrap()
+    }
+
+    /// A spine bone up from the root and a clavicle with an arm bone out along x, all in one
+    /// region: the clavicle keeps the points clearly nearer to its bones (a ≤ λ b) and
+    /// leaves those about as near to the spine (the chest) to it; a leaf keeps every
+    /// point nearer to its guessed bone.
+    #[test]
+    fn a_joint_keeps_only_what_lies_clearly_nearer_its_own_bones() {
+        // 0 root, 1 neck (spine bone 0 → 1), 2 clavicle (its upper bone 0 → 2), 3 arm
+        // (the clavicle's own bone 2 → 3), 4 hand (a leaf below the arm).
+        let skeleton = Skeleton::from_positions(
+            (0..5).map(|k| format!("j{k}")).collect(),
+            vec![NO_PARENT, 0, 0, 2, 3],
+            &[
+                Vec3::ZERO,
+                Vec3::new(0.0, 2.0, 0.0),
+                Vec3::new(0.5, 1.5, 0.0),
+                Vec3::new(1.5, 1.5, 0.0),
+                Vec3::new(2.5, 1.5, 0.0),
+            ],
+        )
+        .unwrap();
+        let decisions: Vec<JointDecision> = (0..5)
+            .map(|k| JointDecision {
+                name: format!("j{k}"),
+                status: JointStatus::Skipped(String::new()),
+                boundary: None,
+                region: Some(0),
+                owns_skin: true,
+            })
+            .collect();
+        let segments = bone_segments(&skeleton);
+        let bones = OwnershipBones::new(&skeleton, &decisions, &segments);
+        let w = 0.05;
+        let clavicle = Ownership::new(&bones, 2, 0, w);
+        // Above the clavicle's bone, 0.2 from it and 0.7 from the spine: kept.
+        assert_eq!(clavicle.at(DVec3::new(0.7, 1.7, 0.0)), 1.0);
+        // The chest below it: 0.5 from the clavicle's bone, 0.6 from the spine. Nearer to
+        // the clavicle, but not clearly: left to the spine.
+        let chest = DVec3::new(0.6, 1.0, 0.0);
+        assert!(chest.distance(DVec3::new(0.6, 1.5, 0.0)) < chest.x);
+        assert_eq!(clavicle.at(chest), 0.0);
+        // A leaf compares plain distances: the hand keeps what is nearer to its guessed
+        // bone (2.5 → 3 along x), here 0.85 times as far as the arm's end.
+        let hand = Ownership::new(&bones, 4, 0, w);
+        let beside = DVec3::new(2.6, 3.275, 0.0);
+        let ratio = (beside.y - 1.5) / beside.distance(DVec3::new(1.5, 1.5, 0.0));
+        assert!(ratio > OWN_BONE_RATIO && ratio < 1.0, "{ratio}");
+        assert_eq!(hand.at(beside), 1.0);
     }
 
     #[test]
@@ -402,14 +480,19 @@ mod tests {
                             DVec3::new(3.0 * u - 1.5, 3.0 * v - 1.0, 3.0 * t - 1.5)
                         };
                         let close = |got: f64, expected: f64| (got - expected).abs() < 1e-9;
-                        let expected = reference_kappa(&own, &other, w, p);
+                        let ratio = if skeleton.children()[joint].is_empty() {
+                            1.0
+                        } else {
+                            OWN_BONE_RATIO
+                        };
+                        let expected = reference_kappa(&own, &other, ratio, w, p);
                         let got = owner.at(p);
                         assert!(
                             close(got, expected),
                             "case {case}, joint {joint}, region {region} at {p}: {got} vs {expected}"
                         );
                         if let Some((beyond, (own, other))) = &beyond {
-                            let expected = reference_kappa(own, other, w, p);
+                            let expected = reference_kappa(own, other, 1.0, w, p);
                             let got = beyond.at(p);
                             assert!(
                                 close(got, expected),
