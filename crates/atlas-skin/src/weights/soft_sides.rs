@@ -46,10 +46,13 @@ impl SoftSide {
 /// Step 3's child sides: for each soft boundary, a flood along edges from the vertices of
 /// the joint's cross-section (within the band |n·(p − o)| ≤ w and within max(D, w) of the
 /// joint), through vertices related to the boundary's region whose signed plane distance
-/// exceeds −w and where κ > 0 ([`super::ownership`]). Where no such vertex lies within
-/// max(D, w) of a joint that has child bones (a coarse mesh whose faces are larger than
-/// the section: KayKit's hips), the seeds are those within d_N + max(D, w), d_N the
-/// distance from the joint to the nearest vertex of the surface. A soft boundary with no
+/// exceeds −w and where κ > 0 ([`super::ownership`]). Where none of those vertices
+/// qualifies because one face spans the band (they lie past its far edge on the parent
+/// side: rignet-val/3615's ponytail at hair2), the seeds are the ends past the band's
+/// near edge (n·(p − o) > w) of their edges. Where still no vertex qualifies and the
+/// joint has child bones (a coarse mesh whose faces are larger than the section: KayKit's
+/// hips), the seeds are those within d_N + max(D, w), d_N the distance from the joint to
+/// the nearest vertex of the surface. A soft boundary with no
 /// cross-section (diameter 0, or no seed: face bones in a mouth cavity or an eye socket,
 /// whose leaf joints are not seeded farther) is inactive: its joint gets no weight and its
 /// region's other joints keep it.
@@ -195,16 +198,32 @@ fn child_side(
     // The seeds: the vertices near the joint (`visit` keeps those of the region; the
     // flood's result does not depend on their order).
     let seed_radius = b.diameter.max(half_width);
-    let mut seed_within = |radius: f64, queue: &mut VecDeque<u32>| {
-        for v in seeds.vertices.within(b.point, radius) {
-            if signed(v as usize) <= half_width {
-                visit(v, queue);
+    let near_band = |radius: f64| {
+        let mut near = seeds.vertices.within(b.point, radius);
+        near.retain(|&v| signed(v as usize) <= half_width);
+        near
+    };
+    let near = near_band(seed_radius);
+    for &v in &near {
+        visit(v, &mut queue);
+    }
+    if queue.is_empty() {
+        // One face spans the band: the section crosses its edges from the vertices near
+        // the joint to the child side past the band, whose ends seed the flood.
+        for &v in &near {
+            if in_region(v as usize) {
+                for &u in d.topology.neighbors(v as usize) {
+                    if signed(u as usize) > half_width {
+                        visit(u, &mut queue);
+                    }
+                }
             }
         }
-    };
-    seed_within(seed_radius, &mut queue);
+    }
     if queue.is_empty() && seeds.beyond_nearest {
-        seed_within(seeds.vertices.nearest(b.point) + seed_radius, &mut queue);
+        for v in near_band(seeds.vertices.nearest(b.point) + seed_radius) {
+            visit(v, &mut queue);
+        }
     }
     if queue.is_empty() {
         return None;
