@@ -182,6 +182,7 @@ fn search_within(
     let mut search = PlaneSearch {
         mesh,
         topology,
+        spheres: surface.spheres,
         other_bones,
         enclosing_other_bones: 0,
         position: frame.position,
@@ -327,6 +328,8 @@ impl NormalBasis {
 struct PlaneSearch<'a> {
     mesh: &'a SurfaceMesh,
     topology: &'a Topology,
+    /// The faces of `mesh` indexed (the sections around J are found through them).
+    spheres: &'a FaceSpheres,
     /// Bones not incident to J near it, as segments.
     other_bones: &'a [[DVec3; 2]],
     /// Count of sections around J turned down for enclosing another bone.
@@ -366,7 +369,7 @@ impl PlaneSearch<'_> {
             normal,
         };
         let mut best: Option<CutCandidate> = None;
-        for curve in self.domain.closed_sections(&plane) {
+        for curve in self.domain.sections_around(&plane, self.spheres) {
             let points = curve.positions(self.mesh, self.topology);
             if !polygon_contains(&points, plane.normal, plane.point) {
                 continue;
@@ -424,6 +427,7 @@ mod tests {
         let (mesh, _) = bent_cylinder(0.2, 1.0, 60.0, 16, 8);
         let topology = Topology::new(&mesh);
         let snap = vertex_snap_distances(&mesh, &topology, 0.01);
+        let spheres = FaceSpheres::new(&mesh);
         let joint = DVec3::Y;
         let through = [[
             joint + 0.05 * DVec3::X - 0.1 * DVec3::Y,
@@ -435,6 +439,7 @@ mod tests {
             let mut new_search = || PlaneSearch {
                 mesh: &mesh,
                 topology: &topology,
+                spheres: &spheres,
                 other_bones,
                 enclosing_other_bones: 0,
                 position: joint,
