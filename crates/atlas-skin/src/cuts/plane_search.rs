@@ -13,7 +13,8 @@
 //! `neighbourhood_factor` × max(surface distance, bone length / 10), gathered once per joint,
 //! doubled up to twice when it holds no closed section around J); a curve reaching the
 //! border of that set is not closed and is discarded. Of the closed
-//! curves, the one whose interior in the plane contains J is kept — unless another bone of
+//! curves (only those that can contain J are traced: `SectionDomain::sections_around`),
+//! the one whose interior in the plane contains J is kept — unless another bone of
 //! the skeleton (one not at J) passes through that interior: such a plane slices a torso
 //! or a palm across other limbs, not the limb at J — and the plane of minimum perimeter F
 //! wins. A pattern search around the best coarse sample refines it.

@@ -79,8 +79,9 @@ pub struct Chord {
 /// query. Everything is indexed locally (vertices, edges and faces of the domain), so that
 /// building a domain costs O(its faces), not O(the mesh), and a query touches only the
 /// domain's own arrays: it computes the signed distance and side of the domain's vertices
-/// and scans its faces; only the few crossed faces are traced, through each local edge's
-/// faces across.
+/// and scans its faces ([`SectionDomain::closed_sections`]), or takes the faces near one
+/// ray from the mesh's face hierarchy ([`SectionDomain::sections_around`]); only crossed
+/// faces are traced, through each local edge's faces across.
 #[derive(Debug, Clone)]
 pub struct SectionDomain {
     /// Per local face: its face of the mesh, its corners and its edges (in the order of

@@ -1,11 +1,13 @@
 //! Point and ray queries against a surface, pruned by per-face bounding spheres: nearest
-//! surface distance, faces near a point, first hit along a ray.
+//! surface distance, faces near a point, first hit along a ray, faces near a segment.
 //!
 //! Faces near a point come from a uniform grid of the sphere centres (about four faces per
 //! cell); the nearest point and ray hits descend a bounding volume hierarchy of the faces'
 //! boxes (the faces in Morton order of their centres, halved recursively: depth ⌈log₂ F⌉
-//! at most); the exact test runs only on faces whose sphere passes.
-//! The decomposition asks them once per joint, never once per candidate plane.
+//! at most); the exact test runs only on faces whose sphere passes. Faces near a segment
+//! descend the same hierarchy through the boxes grown by the distance asked.
+//! The decomposition asks for faces near a point once per joint, and for faces near a
+//! segment once per candidate plane of a large domain (the ray of its containment test).
 
 use super::surface::SurfaceMesh;
 use crate::geometry::closest_point_on_triangle;
