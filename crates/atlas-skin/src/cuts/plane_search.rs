@@ -13,7 +13,8 @@
 //! `neighbourhood_factor` × max(surface distance, bone length / 10), gathered once per joint,
 //! doubled up to twice when it holds no closed section around J); a curve reaching the
 //! border of that set is not closed and is discarded. Of the closed
-//! curves, the one whose interior in the plane contains J is kept — unless another bone of
+//! curves (only those that can contain J are traced: `SectionDomain::sections_around`),
+//! the one whose interior in the plane contains J is kept — unless another bone of
 //! the skeleton (one not at J) passes through that interior: such a plane slices a torso
 //! or a palm across other limbs, not the limb at J — and the plane of minimum perimeter F
 //! wins. A pattern search around the best coarse sample refines it.
@@ -182,6 +183,7 @@ fn search_within(
     let mut search = PlaneSearch {
         mesh,
         topology,
+        spheres: surface.spheres,
         other_bones,
         enclosing_other_bones: 0,
         position: frame.position,
@@ -327,6 +329,8 @@ impl NormalBasis {
 struct PlaneSearch<'a> {
     mesh: &'a SurfaceMesh,
     topology: &'a Topology,
+    /// The faces of `mesh` indexed (the sections around J are found through them).
+    spheres: &'a FaceSpheres,
     /// Bones not incident to J near it, as segments.
     other_bones: &'a [[DVec3; 2]],
     /// Count of sections around J turned down for enclosing another bone.
@@ -366,7 +370,7 @@ impl PlaneSearch<'_> {
             normal,
         };
         let mut best: Option<CutCandidate> = None;
-        for curve in self.domain.closed_sections(&plane) {
+        for curve in self.domain.sections_around(&plane, self.spheres) {
             let points = curve.positions(self.mesh, self.topology);
             if !polygon_contains(&points, plane.normal, plane.point) {
                 continue;
@@ -424,6 +428,7 @@ mod tests {
         let (mesh, _) = bent_cylinder(0.2, 1.0, 60.0, 16, 8);
         let topology = Topology::new(&mesh);
         let snap = vertex_snap_distances(&mesh, &topology, 0.01);
+        let spheres = FaceSpheres::new(&mesh);
         let joint = DVec3::Y;
         let through = [[
             joint + 0.05 * DVec3::X - 0.1 * DVec3::Y,
@@ -435,6 +440,7 @@ mod tests {
             let mut new_search = || PlaneSearch {
                 mesh: &mesh,
                 topology: &topology,
+                spheres: &spheres,
                 other_bones,
                 enclosing_other_bones: 0,
                 position: joint,

@@ -1,11 +1,13 @@
 //! Point and ray queries against a surface, pruned by per-face bounding spheres: nearest
-//! surface distance, faces near a point, first hit along a ray.
+//! surface distance, faces near a point, first hit along a ray, faces near a segment.
 //!
 //! Faces near a point come from a uniform grid of the sphere centres (about four faces per
 //! cell); the nearest point and ray hits descend a bounding volume hierarchy of the faces'
 //! boxes (the faces in Morton order of their centres, halved recursively: depth ⌈log₂ F⌉
-//! at most); the exact test runs only on faces whose sphere passes.
-//! The decomposition asks them once per joint, never once per candidate plane.
+//! at most); the exact test runs only on faces whose sphere passes. Faces near a segment
+//! descend the same hierarchy through the boxes grown by the distance asked.
+//! The decomposition asks for faces near a point once per joint, and for faces near a
+//! segment once per candidate plane of a large domain (the ray of its containment test).
 
 use super::surface::SurfaceMesh;
 use crate::geometry::closest_point_on_triangle;
@@ -330,6 +332,63 @@ impl FaceSpheres {
         faces
     }
 
+    /// Appends to `out` the faces whose sphere comes within `radius` of the segment
+    /// `origin + t · direction`, 0 ≤ t ≤ `length` (`direction` unit length), in the
+    /// hierarchy's order: a superset of the faces within `radius` of the segment. The
+    /// hierarchy is descended through the boxes grown by `radius` that the segment meets,
+    /// so a segment costs the boxes along it, not the faces of the mesh.
+    pub fn faces_near_segment(
+        &self,
+        origin: DVec3,
+        direction: DVec3,
+        length: f64,
+        radius: f64,
+        out: &mut Vec<u32>,
+    ) {
+        let nodes = &self.bvh.nodes;
+        let inverse = |d: f64| if d.abs() < 1e-300 { 1e300 } else { 1.0 / d };
+        let segment = Segment {
+            low_corner: origin + radius,
+            high_corner: origin - radius,
+            inverse: DVec3::new(
+                inverse(direction.x),
+                inverse(direction.y),
+                inverse(direction.z),
+            ),
+            length,
+        };
+        if nodes.is_empty() || !nodes[0].segment_meets(&segment) {
+            return;
+        }
+        // Nodes whose grown box the segment meets, not yet opened: at most one pending
+        // sibling per level of a tree of depth ⌈log₂ F⌉ + 1 < 64.
+        let mut stack = [0u32; 64];
+        let mut size = 1;
+        while size > 0 {
+            size -= 1;
+            let k = stack[size];
+            let node = &nodes[k as usize];
+            if node.count > 0 {
+                let (start, end) = (node.start as usize, (node.start + node.count) as usize);
+                for &f in &self.bvh.faces[start..end] {
+                    let to_centre = self.centres[f as usize] - origin;
+                    let t = to_centre.dot(direction).clamp(0.0, length);
+                    let reach = self.radii[f as usize] + radius;
+                    if (to_centre - direction * t).length_squared() <= reach * reach {
+                        out.push(f);
+                    }
+                }
+                continue;
+            }
+            for child in [k + node.start, k + 1] {
+                if nodes[child as usize].segment_meets(&segment) {
+                    stack[size] = child;
+                    size += 1;
+                }
+            }
+        }
+    }
+
     /// First face hit by the ray `origin + t · direction`, t > 0, `direction` unit length
     /// (Möller–Trumbore 1997 on faces whose sphere the ray meets); of faces hit at the same
     /// t, the lowest index. The hierarchy is descended nearer child first and a node is
@@ -604,6 +663,40 @@ impl BvhNode {
         }
         (near <= far).then_some(near)
     }
+
+    /// Whether `segment` meets the box grown by its radius on every side (slab test).
+    #[inline(always)]
+    fn segment_meets(&self, segment: &Segment) -> bool {
+        // No NaN arises (see `Segment::inverse`), so plain comparisons stand for `min` and
+        // `max` (which would test for NaN).
+        let min = |a: f64, b: f64| if a < b { a } else { b };
+        let max = |a: f64, b: f64| if a > b { a } else { b };
+        let t0 = (self.lo - segment.low_corner) * segment.inverse;
+        let t1 = (self.hi - segment.high_corner) * segment.inverse;
+        let near = max(
+            max(min(t0.x, t1.x), min(t0.y, t1.y)),
+            max(min(t0.z, t1.z), 0.0),
+        );
+        let far = min(
+            min(max(t0.x, t1.x), max(t0.y, t1.y)),
+            min(max(t0.z, t1.z), segment.length),
+        );
+        near <= far
+    }
+}
+
+/// The segment of [`FaceSpheres::faces_near_segment`] with what its box tests reuse.
+struct Segment {
+    /// origin + radius and origin − radius: a box grown by the radius is met where
+    /// (lo − (o + r)) / d and (hi − (o − r)) / d bound t.
+    low_corner: DVec3,
+    high_corner: DVec3,
+    /// 1 / direction per axis, with 10³⁰⁰ for a component below 10⁻³⁰⁰ (taken as 0): a
+    /// product is then a finite number or ±∞, never NaN (0 · ∞), and an axis the segment
+    /// runs parallel to limits nothing when the origin is inside its slab (on a side
+    /// included) and stops the segment at once when outside.
+    inverse: DVec3,
+    length: f64,
 }
 
 /// Möller–Trumbore: t > 0 with origin + t·direction in triangle abc, None when parallel.
@@ -662,6 +755,48 @@ mod tests {
         assert!(near
             .iter()
             .all(|&f| spheres.centres[f as usize].distance(DVec3::Z) < 0.5));
+    }
+
+    /// Faces near a segment: every face with a point within the radius of it (sampled
+    /// along it) is listed, and only faces whose sphere comes that near; segments through,
+    /// along the axes of and outside a sphere.
+    #[test]
+    fn faces_near_a_segment_contain_the_faces_within_reach() {
+        let mesh = icosphere(1.0, 3);
+        let spheres = FaceSpheres::new(&mesh);
+        let cases = [
+            (DVec3::ZERO, DVec3::X, 2.0, 0.05),
+            (
+                DVec3::new(0.1, 0.2, 0.3),
+                DVec3::new(1.0, 2.0, -0.5).normalize(),
+                1.5,
+                0.01,
+            ),
+            (DVec3::new(0.0, 0.0, 0.99), DVec3::Y, 0.3, 0.02),
+            (DVec3::new(3.0, 0.0, 0.0), DVec3::Z, 1.0, 0.1),
+            (DVec3::new(-0.5, 0.0, 0.0), -DVec3::Z, 0.0, 0.0),
+        ];
+        for (origin, direction, length, radius) in cases {
+            let mut near = Vec::new();
+            spheres.faces_near_segment(origin, direction, length, radius, &mut near);
+            let within_reach = (0..mesh.triangle_count()).filter(|&f| {
+                let [a, b, c] = mesh.corners(f);
+                (0..=200).any(|i| {
+                    let p = origin + direction * (length * i as f64 / 200.0);
+                    point_triangle_distance(p, a, b, c) <= radius
+                })
+            });
+            for f in within_reach {
+                assert!(near.contains(&(f as u32)), "{origin} {direction}: face {f}");
+            }
+            for &f in &near {
+                let to_centre = spheres.centres[f as usize] - origin;
+                let t = to_centre.dot(direction).clamp(0.0, length);
+                let gap = (to_centre - direction * t).length();
+                assert!(gap <= spheres.radii[f as usize] + radius + 1e-12);
+            }
+            assert!(near.len() < mesh.triangle_count() / 4);
+        }
     }
 
     /// The reference for [`FaceSpheres::first_hit`]: every face, lowest index on ties.
