@@ -13,7 +13,7 @@ use crate::tolerance::NEGLIGIBLE;
 /// returns how many components were turned. A topology built before must be rebuilt
 /// when the count is positive (face edges follow the winding).
 pub fn turn_inside_out_pieces(mesh: &mut SurfaceMesh, topology: &Topology) -> usize {
-    let (component, count) = topology.vertex_components(mesh);
+    let (component, count) = (&topology.vertex_component, topology.component_count);
     let mut volume = vec![0.0; count];
     let mut closed = vec![true; count];
     for t in &mesh.triangles {
