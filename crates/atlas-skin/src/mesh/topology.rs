@@ -16,7 +16,7 @@ const UNLABELLED: u32 = u32::MAX;
 /// Vertex `v` lies in connected component `vertex_component[v]` of `component_count`
 /// (vertices joined by triangles), numbered by first vertex; a vertex no triangle uses is
 /// a component of its own.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct Topology {
     pub edges: Vec<[u32; 2]>,
     pub face_edges: Vec<[u32; 3]>,
