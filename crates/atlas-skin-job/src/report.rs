@@ -202,7 +202,7 @@ fn pieces_report(skinned: &Skinned) -> Value {
 fn vertex_treatments(skinned: &Skinned) -> Vec<usize> {
     let d = &skinned.decomposition;
     let counts = &skinned.counts.weights;
-    let (piece_of, _) = d.topology.vertex_components(&d.surface);
+    let piece_of = &d.topology.vertex_component;
     let mut of_surface: Vec<usize> = piece_of
         .iter()
         .map(|&c| treatment_index(counts.pieces[c as usize].treatment))

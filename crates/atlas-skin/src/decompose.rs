@@ -132,7 +132,7 @@ pub fn decompose(
     // with a soft joint (the index is kept for the weights).
     let surface_spheres = std::sync::OnceLock::new();
     let holders = (outcomes.iter().any(|o| matches!(o, Outcome::Soft { .. }))
-        && topology.vertex_components(mesh).1 > 1)
+        && topology.component_count > 1)
         .then(|| {
             let spheres = surface_spheres.get_or_init(|| FaceSpheres::new(&surface));
             HoldingRegions::new(&surface, &face_region, spheres)

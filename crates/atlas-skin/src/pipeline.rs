@@ -217,9 +217,8 @@ pub fn skin(
 
     let done = run(Stage::Topology);
     let mut topology = Topology::new(&welded.mesh);
-    let inside_out = turn_inside_out_pieces(&mut welded.mesh, &topology);
+    let inside_out = turn_inside_out_pieces(&mut welded.mesh, &mut topology);
     if inside_out > 0 {
-        topology = Topology::new(&welded.mesh);
         warnings.push(format!(
             "{inside_out} closed piece(s) were wound inside out: turned outward for the method"
         ));

@@ -112,7 +112,7 @@ impl Pieces {
 /// The treatment of the piece that holds stored vertex `stored`.
 fn treatment_of(skinned: &Skinned, stored: usize) -> PieceTreatment {
     let d = &skinned.decomposition;
-    let (piece_of, _) = d.topology.vertex_components(&d.surface);
+    let piece_of = &d.topology.vertex_component;
     let piece = piece_of[skinned.welded_of_stored[stored] as usize];
     skinned.counts.weights.pieces[piece as usize].treatment
 }
@@ -183,7 +183,7 @@ fn a_belt_through_the_waist_takes_the_weights_of_the_body_under_it() {
     );
     let skinned = pieces.skin();
     let d = &skinned.decomposition;
-    let (piece_of, _) = d.topology.vertex_components(&d.surface);
+    let piece_of = &d.topology.vertex_component;
     let body_piece = piece_of[skinned.welded_of_stored[0] as usize];
     let body_faces: Vec<usize> = (0..d.surface.triangle_count())
         .filter(|&f| piece_of[d.surface.triangles[f][0] as usize] == body_piece)

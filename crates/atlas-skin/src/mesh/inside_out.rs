@@ -10,10 +10,12 @@ use crate::tolerance::NEGLIGIBLE;
 
 /// Turns every closed component of negative signed volume outward (each of its triangles
 /// [a, b, c] becomes [a, c, b]) when the mesh as a whole has positive signed volume, and
-/// returns how many components were turned. A topology built before must be rebuilt
-/// when the count is positive (face edges follow the winding).
-pub fn turn_inside_out_pieces(mesh: &mut SurfaceMesh, topology: &Topology) -> usize {
-    let (component, count) = topology.vertex_components(mesh);
+/// returns how many components were turned. `topology` is `mesh`'s and stays so: a turned
+/// face's edges 0 and 2 exchange (edge i joins corners i and i + 1), and nothing else of a
+/// topology depends on the winding (its edges, their faces and the vertices' rows are
+/// ordered by vertex and face index).
+pub fn turn_inside_out_pieces(mesh: &mut SurfaceMesh, topology: &mut Topology) -> usize {
+    let (component, count) = (&topology.vertex_component, topology.component_count);
     let mut volume = vec![0.0; count];
     let mut closed = vec![true; count];
     for t in &mesh.triangles {
@@ -32,9 +34,10 @@ pub fn turn_inside_out_pieces(mesh: &mut SurfaceMesh, topology: &Topology) -> us
     let inward: Vec<bool> = (0..count)
         .map(|k| closed[k] && volume[k] < -negligible)
         .collect();
-    for t in &mut mesh.triangles {
+    for (t, edges) in mesh.triangles.iter_mut().zip(&mut topology.face_edges) {
         if inward[component[t[0] as usize] as usize] {
             t.swap(1, 2);
+            edges.swap(0, 2);
         }
     }
     inward.iter().filter(|&&i| i).count()
@@ -47,7 +50,8 @@ mod tests {
     use glam::DVec3;
 
     /// A big outward sphere and a small one wound inward beside it: the small one is
-    /// turned, the big one kept; a mesh that is inward as a whole is left alone.
+    /// turned, the big one kept, and the topology is that of the turned mesh; a mesh that
+    /// is inward as a whole is left alone.
     #[test]
     fn closed_inward_pieces_beside_an_outward_body_are_turned() {
         let body = icosphere(1.0, 2);
@@ -73,8 +77,9 @@ mod tests {
                 .chain(piece.triangles.iter().map(|t| t.map(|v| v + offset)))
                 .collect(),
         };
-        let topology = Topology::new(&mesh);
-        assert_eq!(turn_inside_out_pieces(&mut mesh, &topology), 1);
+        let mut topology = Topology::new(&mesh);
+        assert_eq!(turn_inside_out_pieces(&mut mesh, &mut topology), 1);
+        assert_eq!(topology, Topology::new(&mesh));
         assert_eq!(&mesh.triangles[..body.triangles.len()], &body.triangles[..]);
         let outward = body.signed_volume() - piece.signed_volume();
         assert!((mesh.signed_volume() - outward).abs() < 1e-9, "{outward}");
@@ -83,7 +88,7 @@ mod tests {
         for t in &mut inward.triangles {
             t.swap(1, 2);
         }
-        let topology = Topology::new(&inward);
-        assert_eq!(turn_inside_out_pieces(&mut inward, &topology), 0);
+        let mut topology = Topology::new(&inward);
+        assert_eq!(turn_inside_out_pieces(&mut inward, &mut topology), 0);
     }
 }

@@ -4,7 +4,7 @@ use super::surface::SurfaceMesh;
 use super::union_find::UnionFind;
 use crate::tolerance::FLAT;
 
-/// A vertex not yet given a component by [`Topology::vertex_components`].
+/// A vertex not yet given a component by [`vertex_components`].
 const UNLABELLED: u32 = u32::MAX;
 
 /// Edges and adjacency of a [`SurfaceMesh`], built once and passed to later stages.
@@ -13,7 +13,10 @@ const UNLABELLED: u32 = u32::MAX;
 /// `i` and `(i + 1) % 3` and is `face_edges[f][i]`. Compressed rows: the faces around edge `e`
 /// are `edge_faces[edge_face_offsets[e]..edge_face_offsets[e + 1]]` (1 on a boundary, 2 inside
 /// a manifold, more on a non-manifold edge); likewise `vertex_faces` and `vertex_neighbors`.
-#[derive(Debug, Clone, Default)]
+/// Vertex `v` lies in connected component `vertex_component[v]` of `component_count`
+/// (vertices joined by triangles), numbered by first vertex; a vertex no triangle uses is
+/// a component of its own.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct Topology {
     pub edges: Vec<[u32; 2]>,
     pub face_edges: Vec<[u32; 3]>,
@@ -23,6 +26,8 @@ pub struct Topology {
     pub vertex_faces: Vec<u32>,
     pub vertex_neighbor_offsets: Vec<u32>,
     pub vertex_neighbors: Vec<u32>,
+    pub vertex_component: Vec<u32>,
+    pub component_count: usize,
 }
 
 impl Topology {
@@ -30,7 +35,9 @@ impl Topology {
     /// smaller vertex with a counting sort (which keeps the stored order (f, i) within a
     /// group), then each group, a few entries, is sorted by its larger vertex (keys
     /// `b · 2³² + 3f + i`, unique, so the order is that of a stable sort by b),
-    /// which gives the order (a, b, f, i) of edges and of their faces.
+    /// which gives the order (a, b, f, i) of edges and of their faces. The components are
+    /// labelled here, once for every stage that reads them (the inside-out pieces, the
+    /// holding regions, the loose pieces of the weights).
     pub fn new(mesh: &SurfaceMesh) -> Self {
         let nv = mesh.vertex_count();
         let triangles = &mesh.triangles;
@@ -110,6 +117,8 @@ impl Topology {
                 *slot += 1;
             }
         }
+        let (vertex_component, component_count) =
+            vertex_components(&vertex_neighbor_offsets, &vertex_neighbors);
         Self {
             edges,
             face_edges,
@@ -119,6 +128,8 @@ impl Topology {
             vertex_faces,
             vertex_neighbor_offsets,
             vertex_neighbors,
+            vertex_component,
+            component_count,
         }
     }
 
@@ -146,32 +157,34 @@ impl Topology {
             .flat_map(move |&e| self.faces_of_edge(e as usize).iter().copied())
             .filter(move |&g| g as usize != f)
     }
+}
 
-    /// Component index of every vertex (vertices joined by triangles), numbered by first
-    /// vertex; vertices no triangle uses get their own component. Returns (#V labels, count).
-    pub fn vertex_components(&self, mesh: &SurfaceMesh) -> (Vec<u32>, usize) {
-        let n = mesh.vertex_count();
-        let mut label = vec![UNLABELLED; n];
-        let mut count = 0u32;
-        let mut stack = Vec::new();
-        for start in 0..n {
-            if label[start] != UNLABELLED {
-                continue;
-            }
-            label[start] = count;
-            stack.push(start);
-            while let Some(v) = stack.pop() {
-                for &u in self.neighbors(v) {
-                    if label[u as usize] == UNLABELLED {
-                        label[u as usize] = count;
-                        stack.push(u as usize);
-                    }
+/// Component index of every vertex of the rows `neighbor_offsets`, `neighbors` (#V + 1 and
+/// 2E), by a depth-first walk from each unlabelled vertex in order, so numbered by first
+/// vertex. Returns (#V labels, count).
+fn vertex_components(neighbor_offsets: &[u32], neighbors: &[u32]) -> (Vec<u32>, usize) {
+    let n = neighbor_offsets.len() - 1;
+    let mut label = vec![UNLABELLED; n];
+    let mut count = 0u32;
+    let mut stack = Vec::new();
+    for start in 0..n {
+        if label[start] != UNLABELLED {
+            continue;
+        }
+        label[start] = count;
+        stack.push(start);
+        while let Some(v) = stack.pop() {
+            let row = neighbor_offsets[v] as usize..neighbor_offsets[v + 1] as usize;
+            for &u in &neighbors[row] {
+                if label[u as usize] == UNLABELLED {
+                    label[u as usize] = count;
+                    stack.push(u as usize);
                 }
             }
-            count += 1;
         }
-        (label, count as usize)
+        count += 1;
     }
+    (label, count as usize)
 }
 
 /// Turns counts `c[1..]` (with `c[0] = 0`) into offsets: `c[i]` becomes the sum of the
@@ -238,7 +251,7 @@ pub struct MeshStats {
 impl MeshStats {
     /// Measures `mesh` with its `topology`.
     pub fn new(mesh: &SurfaceMesh, topology: &Topology) -> Self {
-        let (label, count) = topology.vertex_components(mesh);
+        let (label, count) = (&topology.vertex_component, topology.component_count);
         let mut per = vec![(0usize, 0usize, 0usize, 0usize); count]; // V, E, F, boundary edges
         let mut used = vec![false; mesh.vertex_count()];
         for t in &mesh.triangles {
@@ -252,7 +265,7 @@ impl MeshStats {
                 per[label[v] as usize].0 += 1;
             }
         }
-        let edges = edge_census(mesh, topology, &label, &mut per);
+        let edges = edge_census(mesh, topology, label, &mut per);
         let (boundary_edges, nonmanifold_edges, inconsistent, loops_per) = (
             edges.boundary,
             edges.nonmanifold,
@@ -449,7 +462,7 @@ mod tests {
 
     /// Random triangles over few vertices (non-manifold edges, repeated corners, unused
     /// vertices), the demo's welded surface and an empty mesh: the counting sort builds
-    /// the reference's topology.
+    /// the reference's topology and components.
     #[test]
     fn counting_sort_gives_the_reference_topology() {
         let mut rng = atlas_skin_runtime::random_pose::SplitMix64::new(5);
@@ -489,7 +502,33 @@ mod tests {
                 reference.vertex_neighbor_offsets
             );
             assert_eq!(fast.vertex_neighbors, reference.vertex_neighbors);
+            let (component, count) = reference_components(mesh);
+            assert_eq!(fast.vertex_component, component);
+            assert_eq!(fast.component_count, count);
         }
+    }
+
+    /// The reference components: corners of a triangle joined in a union–find, the sets
+    /// numbered in the order of their first vertex.
+    fn reference_components(mesh: &SurfaceMesh) -> (Vec<u32>, usize) {
+        let mut sets = UnionFind::new(mesh.vertex_count());
+        for &[a, b, c] in &mesh.triangles {
+            sets.union(a, b);
+            sets.union(b, c);
+        }
+        let mut number_of_root = vec![u32::MAX; mesh.vertex_count()];
+        let mut count = 0;
+        let component = (0..mesh.vertex_count() as u32)
+            .map(|v| {
+                let root = sets.find(v) as usize;
+                if number_of_root[root] == u32::MAX {
+                    number_of_root[root] = count;
+                    count += 1;
+                }
+                number_of_root[root]
+            })
+            .collect();
+        (component, count as usize)
     }
 
     #[test]

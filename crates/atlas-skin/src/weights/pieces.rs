@@ -109,7 +109,8 @@ pub fn weight_pieces(
     let empty: Vec<bool> = (0..n)
         .map(|v| weights.offsets[v] == weights.offsets[v + 1])
         .collect();
-    let (piece_of, piece_count) = decomposition.topology.vertex_components(surface);
+    let topology = &decomposition.topology;
+    let (piece_of, piece_count) = (&topology.vertex_component, topology.component_count);
     let mut members: Vec<Vec<u32>> = vec![Vec::new(); piece_count];
     for (v, &c) in piece_of.iter().enumerate() {
         members[c as usize].push(v as u32);
@@ -151,7 +152,7 @@ pub fn weight_pieces(
             piece: c,
             gap: false,
         }));
-        units.extend(body_gaps(decomposition, &empty, &is_body, &piece_of));
+        units.extend(body_gaps(decomposition, &empty, &is_body, piece_of));
     }
     let held: Vec<Vec<(u32, DVec3, DVec3)>> = units
         .par_iter()
