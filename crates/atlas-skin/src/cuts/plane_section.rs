@@ -119,6 +119,13 @@ pub struct SectionDomain {
     chain_faces: Vec<u32>,
 }
 
+/// Whether the plane crosses a face: 1 or 2 of its corners on the non-negative side
+/// (`side`: 1 for a vertex on the plane or its positive side, else 0).
+#[inline(always)]
+fn face_crossed(side: &[u8], [a, b, c]: [u32; 3]) -> bool {
+    (side[a as usize] + side[b as usize] + side[c as usize]).wrapping_sub(1) < 2
+}
+
 /// Below this many faces a domain's scan (about 13 instructions a face, and the tracing of
 /// every section) costs less than the descent of the face hierarchy along a segment (60 to
 /// 80 boxes of about 120 instructions on the benchmark's characters) and the rotation of
@@ -285,9 +292,8 @@ impl SectionDomain {
         crossed.clear();
         // A slice, not the vector, so that its start and length stay in registers.
         let side: &[u8] = &self.local_side;
-        for (i, &[a, b, c]) in self.local_faces.iter().enumerate() {
-            // 1 or 2 corners on the positive side.
-            if (side[a as usize] + side[b as usize] + side[c as usize]).wrapping_sub(1) < 2 {
+        for (i, &face) in self.local_faces.iter().enumerate() {
+            if face_crossed(side, face) {
                 crossed.push(i as u32);
             }
         }
@@ -352,9 +358,7 @@ impl SectionDomain {
         let mut curves = Vec::new();
         for &f in &near {
             if let Ok(i) = self.faces.binary_search(&f) {
-                let [a, b, c] = self.local_faces[i];
-                let side = &self.local_side;
-                if (side[a as usize] + side[b as usize] + side[c as usize]).wrapping_sub(1) < 2 {
+                if face_crossed(&self.local_side, self.local_faces[i]) {
                     self.trace_from_face(i as u32, &mut curves);
                 }
             }
