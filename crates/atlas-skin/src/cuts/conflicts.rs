@@ -8,7 +8,12 @@
 //! in increasing order of their best perimeter, so the small cross-sections of fingers,
 //! toes and distal limbs are placed before the palm, leg-root, neck and torso planes that
 //! would cross them; branching joints on the mirror plane (a spine joint where the legs or
-//! the arms branch) come after all others, whatever their perimeter. A joint whose best
+//! the arms branch) come after all others, whatever their perimeter. Last come the joints
+//! whose best section is more than [`WIDE_SECTION_RATIO`] times as long as their parent's
+//! best section: a limb narrows or keeps its width from joint to joint, so a section that
+//! much wider than the one before it is not the limb's but a plane through a larger body
+//! beside it (the clavicle of a biped rig, a child of the neck, whose plane slices the side
+//! of the chest); such a cut yields to the joints it would block. A joint whose best
 //! curve conflicts with an already placed one tries its next-best closed sections (the
 //! other sampled planes, by increasing perimeter); when none fits, it gets a soft boundary:
 //! its plane restricted to the region that holds it (METHOD.md, "extensions"), which the
@@ -20,8 +25,13 @@ use super::joint_roles::{JointFrame, JointPlan};
 use super::plane_search::{CutCandidate, CutSearch};
 use super::plane_section::{Chord, CrossingPoint, SectionCurve};
 use crate::mesh::{SurfaceMesh, Topology};
-use atlas_skin_runtime::Skeleton;
+use atlas_skin_runtime::{Skeleton, NO_PARENT};
 use std::collections::HashMap;
+
+/// A joint's best section longer than this many times its parent's best section is placed
+/// last (module documentation). Measured on the benchmark: any ratio from 2 to 4 gives the
+/// same placements (docs/measurements.md, "Sections wider than the parent's").
+pub const WIDE_SECTION_RATIO: f64 = 3.0;
 
 /// Where the conflict rule put a joint's boundary.
 #[derive(Debug, Clone, PartialEq)]
@@ -48,7 +58,7 @@ pub fn place_cuts(
     gap: f64,
 ) -> Vec<Placement> {
     let candidates: Vec<&[CutCandidate]> = searches.iter().map(|s| &s.candidates[..]).collect();
-    let order = placement_order(plans, &candidates);
+    let order = placement_order(plans, &candidates, &skeleton.parents);
     let mut placed_chords: HashMap<u32, Vec<(u32, Chord)>> = HashMap::new();
     let mut vertex_owner: HashMap<u32, u32> = HashMap::new();
     let mut placed: Vec<Option<Result<usize, Vec<u32>>>> = vec![None; plans.len()];
@@ -93,15 +103,31 @@ pub fn place_cuts(
 }
 
 /// The joints that search a cut, in the order of the module documentation: by increasing
-/// best perimeter, branching joints on the mirror plane last.
-fn placement_order(plans: &[JointPlan], candidates: &[&[CutCandidate]]) -> Vec<usize> {
-    let on_mirror_plane =
-        |j: usize| matches!(&plans[j], JointPlan::Boundary(frame) if frame.on_mirror_plane);
+/// best perimeter, branching joints on the mirror plane after the others, joints whose best
+/// section is wider than [`WIDE_SECTION_RATIO`] times their parent's last. `parents` are the
+/// skeleton's ([`NO_PARENT`] for a root).
+fn placement_order(
+    plans: &[JointPlan],
+    candidates: &[&[CutCandidate]],
+    parents: &[u32],
+) -> Vec<usize> {
+    let best_perimeter = |j: usize| candidates[j].first().map(|c| c.perimeter);
+    let group = |j: usize| {
+        let wider_than_parent = parents[j] != NO_PARENT
+            && best_perimeter(parents[j] as usize)
+                .zip(best_perimeter(j))
+                .is_some_and(|(parent, own)| own > WIDE_SECTION_RATIO * parent);
+        if wider_than_parent {
+            2
+        } else {
+            u8::from(matches!(&plans[j], JointPlan::Boundary(frame) if frame.on_mirror_plane))
+        }
+    };
     let mut order: Vec<usize> = (0..plans.len())
         .filter(|&j| matches!(plans[j], JointPlan::Boundary(_)) && !candidates[j].is_empty())
         .collect();
     order.sort_by(|&a, &b| {
-        on_mirror_plane(a).cmp(&on_mirror_plane(b)).then(
+        group(a).cmp(&group(b)).then(
             candidates[a][0]
                 .perimeter
                 .total_cmp(&candidates[b][0].perimeter),
@@ -176,4 +202,64 @@ fn curve_vertices(curve: &SectionCurve) -> Vec<u32> {
     vertices.sort_unstable();
     vertices.dedup();
     vertices
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cuts::plane_section::Plane;
+    use glam::DVec3;
+
+    fn boundary(on_mirror_plane: bool) -> JointPlan {
+        JointPlan::Boundary(JointFrame {
+            position: DVec3::ZERO,
+            upper: DVec3::Y,
+            lower: DVec3::Y,
+            bone_length: 1.0,
+            surface_distance: 0.1,
+            on_mirror_plane,
+        })
+    }
+
+    /// A candidate of this perimeter (the order reads nothing else).
+    fn candidate(perimeter: f64) -> CutCandidate {
+        CutCandidate {
+            plane: Plane {
+                point: DVec3::ZERO,
+                normal: DVec3::Y,
+            },
+            curve: SectionCurve {
+                crossings: Vec::new(),
+                faces: Vec::new(),
+            },
+            points: Vec::new(),
+            perimeter,
+        }
+    }
+
+    /// The order of the joints of a root → chest (on the mirror plane) → neck → clavicle →
+    /// upper arm chain whose best sections have these perimeters.
+    fn order_of_chain(perimeters: [f64; 4]) -> Vec<usize> {
+        let parents = [NO_PARENT, 0, 1, 2, 3];
+        let plans = [
+            JointPlan::Skip("root".into()),
+            boundary(true),
+            boundary(false),
+            boundary(false),
+            boundary(false),
+        ];
+        let candidates: Vec<Vec<CutCandidate>> = std::iter::once(Vec::new())
+            .chain(perimeters.iter().map(|&p| vec![candidate(p)]))
+            .collect();
+        let candidates: Vec<&[CutCandidate]> = candidates.iter().map(|c| &c[..]).collect();
+        placement_order(&plans, &candidates, &parents)
+    }
+
+    #[test]
+    fn a_section_much_wider_than_its_parents_is_placed_last() {
+        // The clavicle's section 4 times the neck's: a plane through the side of the chest.
+        assert_eq!(order_of_chain([1.0, 0.3, 1.2, 0.5]), [2, 4, 1, 3]);
+        // 2.5 times the neck's: a limb's, placed by perimeter before the chest.
+        assert_eq!(order_of_chain([1.0, 0.3, 0.75, 0.5]), [2, 4, 3, 1]);
+    }
 }
