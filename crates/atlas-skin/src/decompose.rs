@@ -362,7 +362,9 @@ fn search_all_cuts(surface: &CutSurface, bones: &BoneIndex, plans: &[JointPlan])
         .par_iter()
         .enumerate()
         .map_init(DomainScratch::default, |scratch, (j, plan)| match plan {
-            JointPlan::Boundary(frame) | JointPlan::Soft(frame, _) => {
+            JointPlan::Boundary(frame)
+            | JointPlan::Soft(frame, _)
+            | JointPlan::CutOrSkip(frame, _) => {
                 find_cut_candidates(surface, j, frame, bones, scratch)
             }
             JointPlan::Skip(_) | JointPlan::Exclude(_) => CutSearch::default(),

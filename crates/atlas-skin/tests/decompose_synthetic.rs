@@ -129,24 +129,49 @@ fn a_leaf_whose_bone_runs_on_into_the_mesh_owns_its_part() {
     assert_eq!(d.regions[b.child_region as usize].joints, [1]);
 }
 
-#[test]
-fn a_leaf_whose_part_turns_away_from_its_bone_owns_it_and_an_end_site_does_not() {
-    // A foot: the leaf sits at the bend, its bone points into the outer wall (the ray along
-    // it leaves the surface about one radius away), the tube runs on past it, turned 45°
-    // like toes beyond the ball of a foot.
-    let (mesh, bent) = bent_cylinder(0.5, 3.0, 45.0, 24, 16);
+/// A tube of radius ½ bent by `bend` degrees at its middle (y = 3), decomposed with a rig
+/// of two joints: `root` at the bottom and the leaf `leaf` at the bend; also the mesh and
+/// the tube's own three-joint skeleton.
+fn leaf_at_bend(bend: f64, leaf: &str) -> (Decomposition, SurfaceMesh, Skeleton) {
+    let (mesh, bent) = bent_cylinder(0.5, 3.0, bend, 24, 16);
     let rig = skeleton(
-        &["root", "ball"],
+        &["root", leaf],
         &[NO_PARENT, 0],
         &[DVec3::ZERO, DVec3::Y * 3.0],
     );
     let d = run(&mesh, &rig);
     check_decomposition(&d, true);
+    (d, mesh, bent)
+}
+
+#[test]
+fn a_leaf_whose_part_turns_away_from_its_bone_owns_it_and_an_end_site_does_not() {
+    // A foot: the leaf sits at the bend, its bone points into the outer wall (the ray along
+    // it leaves the surface about one radius away), the tube runs on past it, turned 45°
+    // like toes beyond the ball of a foot.
+    let (d, mesh, bent) = leaf_at_bend(45.0, "ball");
     let ball = d.joints.iter().find(|j| j.name == "ball").expect("ball");
     assert!(ball.boundary.is_some(), "{:?}", ball.status);
     // The chain's own end joint lies inside the far cap: an end site.
     let d = run(&mesh, &bent);
     assert!(matches!(status(&d, "end"), JointStatus::Skipped(r) if r.starts_with("end site")));
+}
+
+#[test]
+fn a_leaf_whose_part_runs_on_across_its_bone_owns_it_with_a_cut() {
+    // A foot without toe joints: the leaf at the ankle, its leg bone pointing into the
+    // sole, the foot running on at a right angle (rule 5 (c)).
+    let (d, ..) = leaf_at_bend(90.0, "ankle");
+    assert_eq!(*status(&d, "ankle"), JointStatus::Cut);
+    let b = &d.boundaries[0];
+    let foot = &d.regions[b.child_region as usize];
+    assert_eq!(foot.joints, [1]);
+    // The whole foot, past the ankle along x, is the ankle's.
+    for (t, &r) in d.surface.triangles.iter().zip(&d.face_region) {
+        if t.iter().all(|&v| d.surface.positions[v as usize].x > 1.0) {
+            assert_eq!(d.regions[r as usize].joints, [1]);
+        }
+    }
 }
 
 #[test]

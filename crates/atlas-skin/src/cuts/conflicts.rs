@@ -124,7 +124,10 @@ fn placement_order(
         }
     };
     let mut order: Vec<usize> = (0..plans.len())
-        .filter(|&j| matches!(plans[j], JointPlan::Boundary(_)) && !candidates[j].is_empty())
+        .filter(|&j| {
+            matches!(plans[j], JointPlan::Boundary(_) | JointPlan::CutOrSkip(..))
+                && !candidates[j].is_empty()
+        })
         .collect();
     order.sort_by(|&a, &b| {
         group(a).cmp(&group(b)).then(
@@ -152,6 +155,15 @@ fn placement_of(
             return Placement::Soft {
                 reason: reason.clone(),
                 frame: *frame,
+            }
+        }
+        JointPlan::CutOrSkip(frame, reason) => {
+            return match placed {
+                Some(Ok(candidate)) => Placement::Cut {
+                    candidate,
+                    frame: *frame,
+                },
+                _ => Placement::Skip(reason.clone()),
             }
         }
         JointPlan::Boundary(frame) => *frame,
@@ -253,6 +265,33 @@ mod tests {
             .collect();
         let candidates: Vec<&[CutCandidate]> = candidates.iter().map(|c| &c[..]).collect();
         placement_order(&plans, &candidates, &parents)
+    }
+
+    #[test]
+    fn a_leaf_that_owns_its_part_only_with_a_cut_is_skipped_without_one() {
+        let skeleton = Skeleton::from_positions(
+            vec!["leg".into(), "ankle".into()],
+            vec![NO_PARENT, 0],
+            &[glam::Vec3::Y, glam::Vec3::ZERO],
+        )
+        .expect("valid skeleton");
+        let JointPlan::Boundary(frame) = boundary(false) else {
+            unreachable!()
+        };
+        let plan = JointPlan::CutOrSkip(frame, "end site".into());
+        let search = CutSearch::default();
+        let blocked = placement_of(&plan, Some(Err(vec![0])), &search, &skeleton);
+        assert_eq!(blocked, Placement::Skip("end site".into()));
+        let none = placement_of(&plan, None, &search, &skeleton);
+        assert_eq!(none, Placement::Skip("end site".into()));
+        let placed = placement_of(&plan, Some(Ok(2)), &search, &skeleton);
+        assert_eq!(
+            placed,
+            Placement::Cut {
+                candidate: 2,
+                frame
+            }
+        );
     }
 
     #[test]

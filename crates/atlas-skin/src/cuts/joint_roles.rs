@@ -35,6 +35,11 @@
 //!    it within 60° of u, (v − p_J) · u ≥ ½ |v − p_J|, nearer to p_J than to every bone not
 //!    at J — reaches farther than 2 r from p_J. (b) finds toes beyond the ball of a foot, which (a) misses when the foot
 //!    bone points down into the sole. It is then cut with lower bone = upper bone.
+//!    (c) When that part reaches 2 r only within 75° of u ((v − p_J) · u ≥ ¼ |v − p_J|), it
+//!    is a foot without toe joints whose leaf sits at the ankle (the foot runs forward across
+//!    a leg bone pointing down), or a part off the bone that is not the leaf's (a prop
+//!    target beside a hand): the leaf is cut when a closed cut fits and is an end site
+//!    otherwise, never a soft boundary ([`JointPlan::CutOrSkip`]).
 //!    Otherwise it is an end site (a fingertip cap reaches about 1.4–1.7 r): no boundary.
 //! 6. Twist and helper joints on a straight bone are chain joints with collinear bones: they
 //!    are cut perpendicular to the bone (the cone search), and the weights stage blends the
@@ -89,6 +94,8 @@ pub struct JointFrame {
 pub enum JointPlan {
     /// Search a cut (and fall back to a soft boundary).
     Boundary(JointFrame),
+    /// Search a cut; without one no boundary, with the reason for the report (rule 5 (c)).
+    CutOrSkip(JointFrame, String),
     /// A soft boundary only, never a cut, with the reason for the report.
     Soft(JointFrame, String),
     /// No boundary, with the reason for the report.
@@ -112,6 +119,12 @@ const LEAF_REACH_RATIO: f64 = 2.0;
 /// about 45° from a foot bone, while the rim of a broad flat end (a pad under an end site)
 /// lies across it.
 const PAST_COSINE: f64 = 0.5;
+
+/// Rule 5 (c) counts the vertices within about 75° of the leaf's bone (cos = ¼): a foot
+/// running forward from an ankle whose leg bone points down. Chosen on the benchmark: from
+/// ⅕ to 0.3 the same leaves are cut; at 0.15 hand slots beside the palm are too
+/// (docs/measurements.md, "Feet past a leaf at the ankle").
+const OFF_AXIS_COSINE: f64 = 0.25;
 
 /// Rule 5 (b) applies to a joint at least this fraction of its bone from the surface; one
 /// nearer lies in the skin (a face bone): the part nearest to it is a patch of skin, not a
@@ -204,18 +217,23 @@ impl Rig<'_> {
             }
         }
         if self.children[j].is_empty() {
-            let owns = leaf_owns_geometry(
+            let end_site = "end site: the surface does not run on past the joint";
+            match leaf_part(
                 self.mesh,
                 self.spheres,
                 &frame,
                 |radius| self.bones.near(j, self.positions[j], radius),
                 self.orientation,
                 self.params.leaf_extent_ratio,
-            );
-            if !owns {
-                return JointPlan::Skip(
-                    "end site: the surface does not run on past the joint".into(),
-                );
+            ) {
+                LeafPart::Owned => {}
+                LeafPart::OffAxis => {
+                    return JointPlan::CutOrSkip(
+                        frame,
+                        format!("{end_site} along its bone, and no closed cut fits beside it"),
+                    )
+                }
+                LeafPart::None => return JointPlan::Skip(end_site.into()),
             }
         }
         JointPlan::Boundary(frame)
@@ -304,39 +322,58 @@ fn branching_plan(frame: &JointFrame, child_vectors: &[DVec3]) -> Option<JointPl
     None
 }
 
-/// Rule 5: whether the leaf of `frame` owns geometry. `other_bones(radius)`: the bones not
-/// at the leaf within `radius` of it, as segments; `orientation` as from
+/// What rule 5 says of the surface past a leaf joint.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum LeafPart {
+    /// The surface runs on past the joint, along its bone: (a) or (b).
+    Owned,
+    /// It runs on past the joint only across its bone: (c).
+    OffAxis,
+    /// An end site.
+    None,
+}
+
+/// Rule 5 of the module documentation for the leaf of `frame`. `other_bones(radius)`: the
+/// bones not at the leaf within `radius` of it, as segments; `orientation` as from
 /// [`orientation_sign`].
-fn leaf_owns_geometry(
+fn leaf_part(
     mesh: &SurfaceMesh,
     spheres: &FaceSpheres,
     frame: &JointFrame,
     other_bones: impl FnOnce(f64) -> Vec<[DVec3; 2]>,
     orientation: f64,
     extent_ratio: f64,
-) -> bool {
+) -> LeafPart {
     let (p, upper, radius) = (frame.position, frame.upper, frame.surface_distance);
     let threshold = extent_ratio * radius;
     let exit_along_bone = spheres
         .first_hit(mesh, p, upper)
         .filter(|hit| orientation * mesh.scaled_normal(hit.face as usize).dot(upper) >= 0.0);
     if exit_along_bone.is_some_and(|hit| hit.distance >= threshold) {
-        return true;
+        return LeafPart::Owned;
     }
     if radius < INTERIOR_RADIUS * frame.bone_length {
-        return false;
+        return LeafPart::None;
     }
     let reach_threshold = LEAF_REACH_RATIO * radius;
     // A bone nearer than p to a vertex within ρ of p lies within 2ρ of p (3ρ leaves room
     // for rounding): the others need no test.
     let reach_radius = 2.0 * reach_threshold;
     let near_bones = other_bones(3.0 * reach_radius);
-    leaf_reach(mesh, spheres, p, upper, &near_bones, reach_radius) >= reach_threshold
+    let [along, across] = leaf_reach(mesh, spheres, p, upper, &near_bones, reach_radius);
+    if along >= reach_threshold {
+        LeafPart::Owned
+    } else if across >= reach_threshold {
+        LeafPart::OffAxis
+    } else {
+        LeafPart::None
+    }
 }
 
 /// The largest distance from `p` of the surface vertices v within `radius` of it that lie
-/// past it within 60° of the unit `direction` ((v − p) · direction ≥ ½ |v − p|) and nearer
-/// to `p` than to each bone of `other_bones`: how far the part beyond a leaf joint reaches.
+/// past it near the unit `direction` and nearer to `p` than to each bone of
+/// `other_bones`: how far the part beyond a leaf joint reaches, within 60° of `direction`
+/// ((v − p) · direction ≥ ½ |v − p|) and within 75° ([`OFF_AXIS_COSINE`]).
 fn leaf_reach(
     mesh: &SurfaceMesh,
     spheres: &FaceSpheres,
@@ -344,7 +381,7 @@ fn leaf_reach(
     direction: DVec3,
     other_bones: &[[DVec3; 2]],
     radius: f64,
-) -> f64 {
+) -> [f64; 2] {
     let mut vertices: Vec<u32> = spheres
         .faces_near(p, radius)
         .into_iter()
@@ -352,20 +389,24 @@ fn leaf_reach(
         .collect();
     vertices.sort_unstable();
     vertices.dedup();
-    vertices
-        .into_iter()
-        .map(|v| mesh.positions[v as usize])
-        .filter(|&v| {
-            (v - p).dot(direction) >= PAST_COSINE * v.distance(p) && v.distance(p) <= radius
-        })
-        .filter(|&v| {
-            let d = v.distance(p);
-            other_bones
+    let mut reach = [0.0f64; 2];
+    for v in vertices.into_iter().map(|v| mesh.positions[v as usize]) {
+        let d = v.distance(p);
+        let along = (v - p).dot(direction);
+        if d > radius
+            || along < OFF_AXIS_COSINE * d
+            || other_bones
                 .iter()
-                .all(|&[a, b]| point_segment_distance(v, a, b) > d)
-        })
-        .map(|v| v.distance(p))
-        .fold(0.0, f64::max)
+                .any(|&[a, b]| point_segment_distance(v, a, b) <= d)
+        {
+            continue;
+        }
+        if along >= PAST_COSINE * d {
+            reach[0] = reach[0].max(d);
+        }
+        reach[1] = reach[1].max(d);
+    }
+    reach
 }
 
 /// Whether at least four of six rays from `p` first meet the surface leaving it (the hit
@@ -547,5 +588,40 @@ mod tests {
         positions[8] = DVec3::new(0.5, 0.3, -0.6);
         skeleton.inverse_bind[4] = glam::Mat4::from_translation(-positions[4].as_vec3());
         assert!(infer_symmetry_plane(&skeleton, &positions, 0.02).is_none());
+    }
+
+    /// Rule 5 at the bend of a tube of radius ½ bent by `bend` degrees, the leaf's bone
+    /// coming up the first segment: the second segment is the part past the leaf.
+    fn leaf_part_at_bend(bend: f64) -> LeafPart {
+        let (mesh, _) = crate::fixtures::shapes::bent_cylinder(0.5, 3.0, bend, 24, 16);
+        let spheres = FaceSpheres::new(&mesh);
+        let position = DVec3::Y * 3.0;
+        let frame = JointFrame {
+            position,
+            upper: DVec3::Y,
+            lower: DVec3::Y,
+            bone_length: 3.0,
+            surface_distance: spheres.nearest_distance(&mesh, position),
+            on_mirror_plane: false,
+        };
+        let ratio = crate::DecomposeParams::default().leaf_extent_ratio;
+        leaf_part(
+            &mesh,
+            &spheres,
+            &frame,
+            |_| Vec::new(),
+            orientation_sign(&mesh),
+            ratio,
+        )
+    }
+
+    #[test]
+    fn a_part_turned_across_the_leafs_bone_is_the_leafs_only_with_a_cut() {
+        // Toes beyond the ball of a foot: within 60° of the bone.
+        assert_eq!(leaf_part_at_bend(45.0), LeafPart::Owned);
+        // A foot forward of an ankle whose leg bone points down into the sole.
+        assert_eq!(leaf_part_at_bend(90.0), LeafPart::OffAxis);
+        // A straight tube ends at its cap: the ray along the bone leaves it a radius away.
+        assert_eq!(leaf_part_at_bend(0.0), LeafPart::Owned);
     }
 }
