@@ -94,8 +94,8 @@ pub enum JointStatus {
     /// A soft boundary, with why no cut was placed.
     Soft(String),
     /// No boundary, with why (root, end site, branching joint on the mirror plane at the
-    /// skin, outside the mesh and owning no geometry,
-    /// forbidden by the user, ...).
+    /// skin, outside the mesh and owning no geometry, forbidden by the user, named as a
+    /// helper, ...).
     Skipped(String),
 }
 

@@ -251,3 +251,81 @@ fn a_skeleton_that_does_not_sit_in_the_body_is_refused_or_warned_about() {
     let warnings = upside_down.warnings.join("\n");
     assert!(warnings.contains("may not sit in the body"), "{warnings}");
 }
+
+/// The demo with helper joints added as exporters leave them: a KayKit hand slot in the
+/// left palm, a locator in the head, Unreal's foot IK chain (a root at the floor, a target
+/// at each ankle) and a knee pole target in front of the knee. They move no skin and are
+/// named in a warning; every joint of the demo keeps its decision (the locator, a child of
+/// the head, turns the head's plane a little). `--force` gives a helper its skin back.
+#[test]
+fn joints_named_as_helpers_move_no_skin() {
+    let demo = demo();
+    let s = &demo.skeleton;
+    let index_of = |name: &str| s.names.iter().position(|n| n == name).unwrap() as u32;
+    let position = |name: &str| s.bind_positions()[index_of(name) as usize];
+    let helpers = [
+        ("handslot.l", index_of("hand_l"), Vec3::new(0.80, 1.40, 0.0)),
+        ("loc_eye", index_of("head"), Vec3::new(0.0, 1.68, 0.08)),
+        ("ik_foot_root", index_of("hips"), Vec3::ZERO),
+        ("ik_foot_l", s.len() as u32 + 2, position("foot_l")),
+        ("ik_foot_r", s.len() as u32 + 2, position("foot_r")),
+        ("PoleTarget_l", index_of("hips"), Vec3::new(0.11, 0.5, 0.4)),
+    ];
+    let mut names = s.names.clone();
+    let mut parents = s.parents.clone();
+    let mut positions = s.bind_positions();
+    for (name, parent, at) in helpers {
+        names.push(name.into());
+        parents.push(parent);
+        positions.push(at);
+    }
+    let with_helpers = Skeleton::from_positions(names, parents, &positions).unwrap();
+    let plain = run(&demo.positions, &demo.triangles, s).unwrap();
+    let skin_with = |force: Vec<String>| {
+        let params = SkinParams {
+            decompose: atlas_skin::DecomposeParams {
+                force,
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        let input = SkinInput {
+            positions: &demo.positions,
+            triangles: &demo.triangles,
+            skeleton: &with_helpers,
+            end_joints: &[],
+        };
+        skin(input, &params, &mut |_| {}).unwrap()
+    };
+    let skinned = skin_with(Vec::new());
+    let warning = skinned.warnings.join("\n");
+    assert!(
+        warning.contains("6 joint(s) named as helpers")
+            && helpers.iter().all(|(name, ..)| warning.contains(name)),
+        "{warning}"
+    );
+    let mut got = boundaries(&skinned);
+    let helper_decisions = got["joints"].as_array_mut().unwrap().split_off(s.len());
+    assert!(helper_decisions.iter().all(|j| j["reason"]
+        .as_str()
+        .unwrap()
+        .starts_with("named as a helper")));
+    let expected = boundaries(&plain);
+    assert_eq!(got["joints"], expected["joints"]);
+    assert_eq!(got["regions"], expected["regions"]);
+    let weighted = |skinned: &Skinned, joint: usize| {
+        skinned
+            .weights
+            .joints
+            .iter()
+            .zip(&skinned.weights.weights)
+            .any(|(&j, &w)| j as usize == joint && w > 0.0)
+    };
+    assert!((s.len()..with_helpers.len()).all(|j| !weighted(&skinned, j)));
+
+    // Forced, the slot in the palm is a joint again and takes part of the hand.
+    let forced = skin_with(vec!["handslot.l".into()]);
+    assert!(forced.decomposition.joints[s.len()].owns_skin);
+    assert!(weighted(&forced, s.len()));
+    assert!(!forced.warnings.join("\n").contains("handslot.l"));
+}

@@ -1,8 +1,14 @@
 //! Which joints get a boundary (Lu et al. 2008 §3.1, and METHOD.md "Measured on real rigs").
 //!
 //! The rules, in the order they are applied to joint J at bind position p_J:
-//! 1. Forbidden by the user: no boundary, and no skin at all ([`JointPlan::Exclude`]).
-//!    Forced by the user: a boundary, whatever follows.
+//! 1. Forbidden by the user, or named as a helper that deforms nothing (an attachment
+//!    slot, a locator, an IK target: [`crate::skeleton::helpers`]) and not forced: no
+//!    boundary, and no skin at all ([`JointPlan::Exclude`]). A helper's bone still keeps
+//!    the sections of other joints clear of it, and it still counts among its parent's
+//!    child bones (a head's lower bone points toward its locators): leaving it out of
+//!    either lost on the benchmark (rignet-val/7571's shoulders cut through the neck beside
+//!    its locators; docs/measurements.md, "Helper joints by name"). Forced by the user: a
+//!    boundary, whatever follows.
 //! 2. A root has no upper bone to cut: its region is the root region. A joint whose bones
 //!    all have zero length has no direction to cut across: no boundary.
 //! 3. A joint lies outside the mesh and owns no geometry when it is farther from the
@@ -105,6 +111,11 @@ pub enum JointPlan {
     Exclude(String),
 }
 
+/// The report's reason for a joint named as a helper (rule 1).
+pub const HELPER_REASON: &str =
+    "named as a helper that deforms nothing (an attachment slot, a locator, an IK target): \
+     moves no skin";
+
 /// A joint is on the mirror plane within this fraction of the fit tolerance: a pelvis or
 /// chest sits on it to rounding, while the branching joints of an eye or a cheek lie a
 /// few percent of the skeleton's size off it.
@@ -188,8 +199,10 @@ impl Rig<'_> {
     /// The rules of the module documentation, in order, for joint `j`.
     fn plan(&self, j: usize, user: Option<Override>) -> JointPlan {
         let forced = user == Some(Override::Force);
-        if user == Some(Override::Forbid) {
-            return JointPlan::Exclude("forbidden by the user".into());
+        match user {
+            Some(Override::Forbid) => return JointPlan::Exclude("forbidden by the user".into()),
+            Some(Override::Helper) => return JointPlan::Exclude(HELPER_REASON.into()),
+            _ => {}
         }
         if self.skeleton.parent(j).is_none() && !forced {
             return JointPlan::Skip("root joint: no upper bone to cut".into());

@@ -1,6 +1,7 @@
 //! Settings of the decomposition (§3.1 plane search, joint roles, conflicts; §3.2 has
 //! none), their validation, and the user's per-joint overrides.
 
+use crate::skeleton::helpers::helper_joints;
 use atlas_skin_runtime::{RuntimeError, Skeleton};
 use serde::{Deserialize, Serialize};
 
@@ -80,11 +81,14 @@ pub enum DecomposeError {
     Skeleton(#[from] RuntimeError),
 }
 
-/// A user override for one joint.
+/// What overrides the rules at one joint: the user, or the joint's name.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Override {
     Force,
     Forbid,
+    /// Named as a helper that deforms nothing ([`crate::skeleton::helpers`]), and not
+    /// forced by the user.
+    Helper,
 }
 
 impl DecomposeParams {
@@ -147,7 +151,8 @@ impl DecomposeParams {
         Ok(())
     }
 
-    /// Per joint: forced, forbidden or neither; names not in the skeleton are errors.
+    /// Per joint: forced, forbidden, a helper by its name, or none of these; names not in the
+    /// skeleton are errors.
     pub fn overrides(&self, skeleton: &Skeleton) -> Result<Vec<Option<Override>>, DecomposeError> {
         let mut overrides = vec![None; skeleton.len()];
         for (list, names, value) in [
@@ -165,6 +170,11 @@ impl DecomposeParams {
                     return Err(DecomposeError::ForcedAndForbidden { name: name.clone() });
                 }
                 overrides[j] = Some(value);
+            }
+        }
+        for (o, helper) in overrides.iter_mut().zip(helper_joints(skeleton)) {
+            if helper && o.is_none() {
+                *o = Some(Override::Helper);
             }
         }
         Ok(overrides)

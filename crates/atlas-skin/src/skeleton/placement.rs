@@ -4,7 +4,8 @@
 //! outside the surface (a skeleton moved, flipped or scaled against its mesh) and a
 //! decomposition without any boundary are warned about, never silent.
 
-use crate::decomposition::Decomposition;
+use crate::cuts::joint_roles::HELPER_REASON;
+use crate::decomposition::{Decomposition, JointDecision, JointStatus};
 use crate::geometry::bounding_box;
 use crate::tolerance::NEGLIGIBLE;
 use atlas_skin_runtime::Skeleton;
@@ -126,9 +127,24 @@ pub fn check_placement(
 pub fn decomposition_warnings(decomposition: &Decomposition, forbidden: &[String]) -> Vec<String> {
     let joints = &decomposition.joints;
     let mut warnings = Vec::new();
+    let is_helper =
+        |j: &JointDecision| matches!(&j.status, JointStatus::Skipped(r) if r == HELPER_REASON);
+    let helpers: Vec<String> = joints
+        .iter()
+        .filter(|j| is_helper(j))
+        .map(|j| j.name.clone())
+        .collect();
+    if !helpers.is_empty() {
+        warnings.push(format!(
+            "{} joint(s) named as helpers that deform nothing (attachment slots, locators, IK \
+             targets) move no skin; `--force JOINT` weights one: {}",
+            helpers.len(),
+            listed(helpers.into_iter())
+        ));
+    }
     let outside: Vec<String> = joints
         .iter()
-        .filter(|j| !j.owns_skin && !forbidden.contains(&j.name))
+        .filter(|j| !j.owns_skin && !forbidden.contains(&j.name) && !is_helper(j))
         .map(|j| j.name.clone())
         .collect();
     if joints.len() >= 2 && 2 * outside.len() >= joints.len() {
