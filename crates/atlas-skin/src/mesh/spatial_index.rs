@@ -173,7 +173,11 @@ pub struct NearestPoint {
 impl NearestPoint {
     /// The nearest point of face `face` of `mesh` to `p`.
     pub fn on_face(mesh: &SurfaceMesh, face: u32, p: DVec3) -> Self {
-        let [a, b, c] = mesh.corners(face as usize);
+        Self::on_corners(face, mesh.corners(face as usize), p)
+    }
+
+    /// [`Self::on_face`] of the face `face` whose corners are `[a, b, c]`.
+    fn on_corners(face: u32, [a, b, c]: [DVec3; 3], p: DVec3) -> Self {
         let barycentric = closest_point_on_triangle(p, a, b, c);
         let [u, v, w] = barycentric;
         Self {
@@ -230,8 +234,8 @@ impl FaceSpheres {
     /// Branch and bound on the hierarchy of face boxes: the distance from `p` to a node's
     /// box bounds the distance to each of its faces from below, so a node is opened only
     /// while that bound is at most the best distance so far, nearer child first, and a
-    /// face is tested exactly only when |p − c_f| − r_f (its sphere) is at most the best
-    /// too. A query costs O(log F) boxes and a few triangles however far `p` lies from
+    /// face is tested exactly only when |p − c_f| − r_f (its sphere) and the distance to its
+    /// own box (padded as the nodes' are) are at most the best too. A query costs O(log F) boxes and a few triangles however far `p` lies from
     /// the surface (the grid's shells of cells grew with that distance). The result is
     /// that of a scan of all faces in index order keeping strictly nearer ones
     /// (`nearest_point_by_scan` in the tests): a face can be skipped only when its bound
@@ -278,7 +282,14 @@ impl FaceSpheres {
                     if self.centres[f as usize].distance(p) - self.radii[f as usize] > limit {
                         continue;
                     }
-                    let candidate = NearestPoint::on_face(mesh, f, p);
+                    // The face's box bounds it more tightly than its sphere where the
+                    // surface runs flat under p: the faces beside the nearest are skipped.
+                    let corners = mesh.corners(f as usize);
+                    let [lo, hi] = padded_box(corners, self.bvh.pad);
+                    if box_distance_squared(lo, hi, p) > limit * limit {
+                        continue;
+                    }
+                    let candidate = NearestPoint::on_corners(f, corners, p);
                     let nearer = candidate.distance < limit
                         || best.is_some_and(|b| candidate.distance == b.distance && f < b.face);
                     if nearer {
@@ -510,6 +521,8 @@ struct FaceBvh {
     nodes: Vec<BvhNode>,
     /// Face indices, each leaf's a contiguous run.
     faces: Vec<u32>,
+    /// What every box is grown by on each side ([`padded_box`]).
+    pad: f64,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -530,12 +543,9 @@ impl FaceBvh {
     /// hit Möller–Trumbore rounds out of its face's box is still found.
     fn new(mesh: &SurfaceMesh, centres: &[DVec3]) -> Self {
         let (lo, hi) = mesh.bounding_box();
-        let pad = DVec3::splat(1e-9 * (hi - lo).max_element().max(f64::MIN_POSITIVE));
+        let pad = 1e-9 * (hi - lo).max_element().max(f64::MIN_POSITIVE);
         let boxes: Vec<[DVec3; 2]> = (0..mesh.triangle_count())
-            .map(|f| {
-                let [a, b, c] = mesh.corners(f);
-                [a.min(b).min(c) - pad, a.max(b).max(c) + pad]
-            })
+            .map(|f| padded_box(mesh.corners(f), pad))
             .collect();
         let (centre_lo, centre_hi) = crate::geometry::bounding_box(centres);
         let scale = MORTON_CELLS / (centre_hi - centre_lo).max(DVec3::splat(f64::MIN_POSITIVE));
@@ -547,6 +557,7 @@ impl FaceBvh {
         let mut bvh = Self {
             nodes: Vec::with_capacity(2 * centres.len() / LEAF_FACES + 1),
             faces: sort_by_code(keyed).into_iter().map(|(_, f)| f).collect(),
+            pad,
         };
         if !bvh.faces.is_empty() {
             bvh.build(0..bvh.faces.len(), &boxes);
@@ -636,13 +647,23 @@ fn morton_code(cell: glam::UVec3) -> u64 {
     spread(cell.x) | spread(cell.y) << 1 | spread(cell.z) << 2
 }
 
+/// The box of a face's corners grown by `pad` on each side: a point of the face that a
+/// computation rounds out of its exact box still lies in it.
+#[inline(always)]
+fn padded_box([a, b, c]: [DVec3; 3], pad: f64) -> [DVec3; 2] {
+    [a.min(b).min(c) - pad, a.max(b).max(c) + pad]
+}
+
+/// Squared distance from `p` to the box `lo..=hi`, 0 inside it.
+#[inline(always)]
+fn box_distance_squared(lo: DVec3, hi: DVec3, p: DVec3) -> f64 {
+    (lo - p).max(p - hi).max(DVec3::ZERO).length_squared()
+}
+
 impl BvhNode {
     /// Squared distance from `p` to the box, 0 inside it.
     fn distance_squared(&self, p: DVec3) -> f64 {
-        (self.lo - p)
-            .max(p - self.hi)
-            .max(DVec3::ZERO)
-            .length_squared()
+        box_distance_squared(self.lo, self.hi, p)
     }
 
     /// Smallest t ≥ 0 at which the ray is in the box (slab test), `None` when it misses.
