@@ -555,13 +555,17 @@ impl FaceBvh {
             .map(|(f, c)| (morton_code(((*c - centre_lo) * scale).as_uvec3()), f as u32))
             .collect();
         let mut bvh = Self {
-            nodes: Vec::with_capacity(2 * centres.len() / LEAF_FACES + 1),
+            // At most F nodes, so the list never grows (grown, it was copied once): a range
+            // of more than LEAF_FACES faces is halved into two of at least 2, so a tree of
+            // F ≥ 2 faces has at most F / 2 leaves and F − 1 nodes.
+            nodes: Vec::with_capacity(centres.len()),
             faces: sort_by_code(keyed).into_iter().map(|(_, f)| f).collect(),
             pad,
         };
         if !bvh.faces.is_empty() {
             bvh.build(0..bvh.faces.len(), &boxes);
         }
+        debug_assert!(bvh.nodes.len() <= centres.len());
         bvh
     }
 
@@ -600,30 +604,33 @@ const RADIX_BITS: u32 = 11;
 /// and then face, as `sort_unstable` sorts the pairs: a least significant digit radix
 /// sort, ⌈63 / 11⌉ = 6 counting passes of 2¹¹ buckets, O(F) (a pass whose digit is the
 /// same for every code is skipped). Each pass is stable, so faces of one code stay
-/// increasing. (The comparison sort it replaces took about 200 instructions per face; the
-/// passes about 40.)
+/// increasing. The passes permute the same codes, so every pass's counts are taken in one
+/// read of the codes before the first. (The comparison sort it replaces took about 200
+/// instructions per face; the passes about 40.)
 fn sort_by_code(mut keyed: Vec<(u64, u32)>) -> Vec<(u64, u32)> {
     const BUCKETS: usize = 1 << RADIX_BITS;
+    const PASSES: usize = 63u32.div_ceil(RADIX_BITS) as usize;
     debug_assert!(keyed.windows(2).all(|w| w[0].1 < w[1].1));
-    let mut other = vec![(0u64, 0u32); keyed.len()];
-    let mut counts = vec![0usize; BUCKETS];
-    for pass in 0..63u32.div_ceil(RADIX_BITS) {
-        let shift = pass * RADIX_BITS;
-        let digit = |code: u64| ((code >> shift) as usize) & (BUCKETS - 1);
-        counts.fill(0);
-        for &(code, _) in &keyed {
-            counts[digit(code)] += 1;
+    let digit =
+        |code: u64, pass: usize| ((code >> (pass as u32 * RADIX_BITS)) as usize) & (BUCKETS - 1);
+    let mut counts = vec![[0u32; BUCKETS]; PASSES];
+    for &(code, _) in &keyed {
+        for (pass, pass_counts) in counts.iter_mut().enumerate() {
+            pass_counts[digit(code, pass)] += 1;
         }
-        if counts.contains(&keyed.len()) {
+    }
+    let mut other = vec![(0u64, 0u32); keyed.len()];
+    for (pass, slots) in counts.iter_mut().enumerate() {
+        if slots.contains(&(keyed.len() as u32)) {
             continue;
         }
         let mut next = 0;
-        for count in counts.iter_mut() {
+        for count in slots.iter_mut() {
             (*count, next) = (next, next + *count);
         }
         for &(code, face) in &keyed {
-            let slot = &mut counts[digit(code)];
-            other[*slot] = (code, face);
+            let slot = &mut slots[digit(code, pass)];
+            other[*slot as usize] = (code, face);
             *slot += 1;
         }
         std::mem::swap(&mut keyed, &mut other);
