@@ -195,8 +195,9 @@ impl SectionDomain {
             edge: local_edge_of,
             face: local_face_of,
         } = scratch;
-        let mut vertices = Vec::new();
-        let mut edges = Vec::new();
+        // At most three of each per face: the lists never grow.
+        let mut vertices = Vec::with_capacity(3 * faces.len());
+        let mut edges = Vec::with_capacity(3 * faces.len());
         // Slot 0 means "not yet local"; a local index is stored plus one.
         let local = |slots: &mut [u32], list: &mut Vec<u32>, global: u32| {
             let slot = &mut slots[global as usize];

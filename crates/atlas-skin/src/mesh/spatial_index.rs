@@ -173,7 +173,11 @@ pub struct NearestPoint {
 impl NearestPoint {
     /// The nearest point of face `face` of `mesh` to `p`.
     pub fn on_face(mesh: &SurfaceMesh, face: u32, p: DVec3) -> Self {
-        let [a, b, c] = mesh.corners(face as usize);
+        Self::on_corners(face, mesh.corners(face as usize), p)
+    }
+
+    /// [`Self::on_face`] of the face `face` whose corners are `[a, b, c]`.
+    fn on_corners(face: u32, [a, b, c]: [DVec3; 3], p: DVec3) -> Self {
         let barycentric = closest_point_on_triangle(p, a, b, c);
         let [u, v, w] = barycentric;
         Self {
@@ -230,8 +234,8 @@ impl FaceSpheres {
     /// Branch and bound on the hierarchy of face boxes: the distance from `p` to a node's
     /// box bounds the distance to each of its faces from below, so a node is opened only
     /// while that bound is at most the best distance so far, nearer child first, and a
-    /// face is tested exactly only when |p − c_f| − r_f (its sphere) is at most the best
-    /// too. A query costs O(log F) boxes and a few triangles however far `p` lies from
+    /// face is tested exactly only when |p − c_f| − r_f (its sphere) and the distance to its
+    /// own box (padded as the nodes' are) are at most the best too. A query costs O(log F) boxes and a few triangles however far `p` lies from
     /// the surface (the grid's shells of cells grew with that distance). The result is
     /// that of a scan of all faces in index order keeping strictly nearer ones
     /// (`nearest_point_by_scan` in the tests): a face can be skipped only when its bound
@@ -278,7 +282,14 @@ impl FaceSpheres {
                     if self.centres[f as usize].distance(p) - self.radii[f as usize] > limit {
                         continue;
                     }
-                    let candidate = NearestPoint::on_face(mesh, f, p);
+                    // The face's box bounds it more tightly than its sphere where the
+                    // surface runs flat under p: the faces beside the nearest are skipped.
+                    let corners = mesh.corners(f as usize);
+                    let [lo, hi] = padded_box(corners, self.bvh.pad);
+                    if box_distance_squared(lo, hi, p) > limit * limit {
+                        continue;
+                    }
+                    let candidate = NearestPoint::on_corners(f, corners, p);
                     let nearer = candidate.distance < limit
                         || best.is_some_and(|b| candidate.distance == b.distance && f < b.face);
                     if nearer {
@@ -510,6 +521,8 @@ struct FaceBvh {
     nodes: Vec<BvhNode>,
     /// Face indices, each leaf's a contiguous run.
     faces: Vec<u32>,
+    /// What every box is grown by on each side ([`padded_box`]).
+    pad: f64,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -530,12 +543,9 @@ impl FaceBvh {
     /// hit Möller–Trumbore rounds out of its face's box is still found.
     fn new(mesh: &SurfaceMesh, centres: &[DVec3]) -> Self {
         let (lo, hi) = mesh.bounding_box();
-        let pad = DVec3::splat(1e-9 * (hi - lo).max_element().max(f64::MIN_POSITIVE));
+        let pad = 1e-9 * (hi - lo).max_element().max(f64::MIN_POSITIVE);
         let boxes: Vec<[DVec3; 2]> = (0..mesh.triangle_count())
-            .map(|f| {
-                let [a, b, c] = mesh.corners(f);
-                [a.min(b).min(c) - pad, a.max(b).max(c) + pad]
-            })
+            .map(|f| padded_box(mesh.corners(f), pad))
             .collect();
         let (centre_lo, centre_hi) = crate::geometry::bounding_box(centres);
         let scale = MORTON_CELLS / (centre_hi - centre_lo).max(DVec3::splat(f64::MIN_POSITIVE));
@@ -545,12 +555,17 @@ impl FaceBvh {
             .map(|(f, c)| (morton_code(((*c - centre_lo) * scale).as_uvec3()), f as u32))
             .collect();
         let mut bvh = Self {
-            nodes: Vec::with_capacity(2 * centres.len() / LEAF_FACES + 1),
+            // At most F nodes, so the list never grows (grown, it was copied once): a range
+            // of more than LEAF_FACES faces is halved into two of at least 2, so a tree of
+            // F ≥ 2 faces has at most F / 2 leaves and F − 1 nodes.
+            nodes: Vec::with_capacity(centres.len()),
             faces: sort_by_code(keyed).into_iter().map(|(_, f)| f).collect(),
+            pad,
         };
         if !bvh.faces.is_empty() {
             bvh.build(0..bvh.faces.len(), &boxes);
         }
+        debug_assert!(bvh.nodes.len() <= centres.len());
         bvh
     }
 
@@ -589,30 +604,33 @@ const RADIX_BITS: u32 = 11;
 /// and then face, as `sort_unstable` sorts the pairs: a least significant digit radix
 /// sort, ⌈63 / 11⌉ = 6 counting passes of 2¹¹ buckets, O(F) (a pass whose digit is the
 /// same for every code is skipped). Each pass is stable, so faces of one code stay
-/// increasing. (The comparison sort it replaces took about 200 instructions per face; the
-/// passes about 40.)
+/// increasing. The passes permute the same codes, so every pass's counts are taken in one
+/// read of the codes before the first. (The comparison sort it replaces took about 200
+/// instructions per face; the passes about 40.)
 fn sort_by_code(mut keyed: Vec<(u64, u32)>) -> Vec<(u64, u32)> {
     const BUCKETS: usize = 1 << RADIX_BITS;
+    const PASSES: usize = 63u32.div_ceil(RADIX_BITS) as usize;
     debug_assert!(keyed.windows(2).all(|w| w[0].1 < w[1].1));
-    let mut other = vec![(0u64, 0u32); keyed.len()];
-    let mut counts = vec![0usize; BUCKETS];
-    for pass in 0..63u32.div_ceil(RADIX_BITS) {
-        let shift = pass * RADIX_BITS;
-        let digit = |code: u64| ((code >> shift) as usize) & (BUCKETS - 1);
-        counts.fill(0);
-        for &(code, _) in &keyed {
-            counts[digit(code)] += 1;
+    let digit =
+        |code: u64, pass: usize| ((code >> (pass as u32 * RADIX_BITS)) as usize) & (BUCKETS - 1);
+    let mut counts = vec![[0u32; BUCKETS]; PASSES];
+    for &(code, _) in &keyed {
+        for (pass, pass_counts) in counts.iter_mut().enumerate() {
+            pass_counts[digit(code, pass)] += 1;
         }
-        if counts.contains(&keyed.len()) {
+    }
+    let mut other = vec![(0u64, 0u32); keyed.len()];
+    for (pass, slots) in counts.iter_mut().enumerate() {
+        if slots.contains(&(keyed.len() as u32)) {
             continue;
         }
         let mut next = 0;
-        for count in counts.iter_mut() {
+        for count in slots.iter_mut() {
             (*count, next) = (next, next + *count);
         }
         for &(code, face) in &keyed {
-            let slot = &mut counts[digit(code)];
-            other[*slot] = (code, face);
+            let slot = &mut slots[digit(code, pass)];
+            other[*slot as usize] = (code, face);
             *slot += 1;
         }
         std::mem::swap(&mut keyed, &mut other);
@@ -636,13 +654,23 @@ fn morton_code(cell: glam::UVec3) -> u64 {
     spread(cell.x) | spread(cell.y) << 1 | spread(cell.z) << 2
 }
 
+/// The box of a face's corners grown by `pad` on each side: a point of the face that a
+/// computation rounds out of its exact box still lies in it.
+#[inline(always)]
+fn padded_box([a, b, c]: [DVec3; 3], pad: f64) -> [DVec3; 2] {
+    [a.min(b).min(c) - pad, a.max(b).max(c) + pad]
+}
+
+/// Squared distance from `p` to the box `lo..=hi`, 0 inside it.
+#[inline(always)]
+fn box_distance_squared(lo: DVec3, hi: DVec3, p: DVec3) -> f64 {
+    (lo - p).max(p - hi).max(DVec3::ZERO).length_squared()
+}
+
 impl BvhNode {
     /// Squared distance from `p` to the box, 0 inside it.
     fn distance_squared(&self, p: DVec3) -> f64 {
-        (self.lo - p)
-            .max(p - self.hi)
-            .max(DVec3::ZERO)
-            .length_squared()
+        box_distance_squared(self.lo, self.hi, p)
     }
 
     /// Smallest t ≥ 0 at which the ray is in the box (slab test), `None` when it misses.
