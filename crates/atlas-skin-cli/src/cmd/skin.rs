@@ -55,7 +55,8 @@ pub struct MethodArgs {
     /// or the paper's Eq. 1.
     #[arg(long, value_enum)]
     pub blend: Option<BlendArg>,
-    /// Give this joint a boundary even where the rules would not (repeatable).
+    /// Give this joint a boundary even where the rules would not, also one named as a
+    /// helper that otherwise moves no skin (repeatable).
     #[arg(long, value_name = "JOINT")]
     pub force: Vec<String>,
     /// Give this joint no boundary: its part moves with its parent's (repeatable).

@@ -1,5 +1,5 @@
 //! Settings of the decomposition (§3.1 plane search, joint roles, conflicts; §3.2 has
-//! none), their validation, and the user's per-joint overrides.
+//! none), their validation, and the per-joint overrides: the user's, and helper names.
 
 use crate::skeleton::helpers::helper_joints;
 use atlas_skin_runtime::{RuntimeError, Skeleton};
