@@ -18,6 +18,11 @@
 //! other sampled planes, by increasing perimeter); when none fits, it gets a soft boundary:
 //! its plane restricted to the region that holds it (METHOD.md, "extensions"), which the
 //! weights stage blends across; so does a joint that [`crate::cuts::joint_roles`] allows no cut.
+//! Mirror twins are the exception to first come, first served: when every section of a
+//! joint crosses the cut of its mirror twin ([`crate::cuts::joint_roles::mirror_twins`]:
+//! the other thigh of legs modelled as one skirt-like piece), the twin's cut is taken back
+//! and both get soft boundaries, so that the two sides of a symmetric character bend alike
+//! (docs/measurements.md, "Mirror twins whose cuts cross").
 //! A joint is left without a boundary only for the reasons of [`crate::cuts::joint_roles`], or
 //! when no region holds it (an empty surface); the report says which.
 
@@ -32,6 +37,17 @@ use std::collections::HashMap;
 /// last (module documentation). Measured on the benchmark: any ratio from 2 to 4 gives the
 /// same placements (docs/measurements.md, "Sections wider than the parent's").
 pub const WIDE_SECTION_RATIO: f64 = 3.0;
+
+/// What the search of one joint found among the placed cuts.
+#[derive(Debug, Clone, PartialEq)]
+enum Search {
+    /// The index of the first candidate that conflicts with no placed cut.
+    Accepted(usize),
+    /// Every candidate conflicts with a placed cut: the joints of those cuts.
+    Blocked(Vec<u32>),
+    /// Every candidate conflicts with the cut of this mirror twin: neither keeps a cut.
+    TwinsCross(u32),
+}
 
 /// Where the conflict rule put a joint's boundary.
 #[derive(Debug, Clone, PartialEq)]
@@ -58,41 +74,36 @@ pub fn place_cuts(
     gap: f64,
 ) -> Vec<Placement> {
     let candidates: Vec<&[CutCandidate]> = searches.iter().map(|s| &s.candidates[..]).collect();
-    let order = placement_order(plans, &candidates, &skeleton.parents);
-    let mut placed_chords: HashMap<u32, Vec<(u32, Chord)>> = HashMap::new();
-    let mut vertex_owner: HashMap<u32, u32> = HashMap::new();
-    let mut placed: Vec<Option<Result<usize, Vec<u32>>>> = vec![None; plans.len()];
-    for j in order {
+    let mut board = Board::default();
+    let mut placed: Vec<Option<Search>> = vec![None; plans.len()];
+    for j in placement_order(plans, &candidates, &skeleton.parents) {
         let mut blockers: Vec<u32> = Vec::new();
-        let mut accepted = None;
-        for (k, candidate) in candidates[j].iter().enumerate() {
-            let chords: Vec<Chord> = candidate.curve.chords(mesh, topology).collect();
-            let vertices = curve_vertices(&candidate.curve);
-            let before = blockers.len();
-            blockers.extend(vertices.iter().filter_map(|v| vertex_owner.get(v).copied()));
-            for chord in &chords {
-                if let Some(others) = placed_chords.get(&chord.face) {
-                    blockers.extend(
-                        others
-                            .iter()
-                            .filter(|(_, other)| chord.crosses_or_touches(other, gap))
-                            .map(|(owner, _)| *owner),
-                    );
+        let accepted = candidates[j].iter().position(|candidate| {
+            match board.fits(mesh, topology, &candidate.curve, gap) {
+                Ok(()) => true,
+                Err(others) => {
+                    blockers.extend(others);
+                    false
                 }
             }
-            if blockers.len() == before {
-                for chord in chords {
-                    placed_chords
-                        .entry(chord.face)
-                        .or_default()
-                        .push((j as u32, chord));
-                }
-                vertex_owner.extend(vertices.into_iter().map(|v| (v, j as u32)));
-                accepted = Some(k);
-                break;
+        });
+        placed[j] = Some(match accepted {
+            Some(k) => {
+                board.place(mesh, topology, j as u32, &candidates[j][k].curve);
+                Search::Accepted(k)
             }
-        }
-        placed[j] = Some(accepted.ok_or(blockers));
+            None => match mirror_twin(&plans[j]) {
+                Some(twin)
+                    if blockers.contains(&twin)
+                        && matches!(placed[twin as usize], Some(Search::Accepted(_))) =>
+                {
+                    board.remove(twin);
+                    placed[twin as usize] = Some(Search::TwinsCross(j as u32));
+                    Search::TwinsCross(twin)
+                }
+                _ => Search::Blocked(blockers),
+            },
+        });
     }
     plans
         .iter()
@@ -100,6 +111,70 @@ pub fn place_cuts(
         .zip(searches)
         .map(|((plan, placed), search)| placement_of(plan, placed, search, skeleton))
         .collect()
+}
+
+/// The cuts placed so far: their chords by face and the vertices they run through.
+#[derive(Default)]
+struct Board {
+    chords: HashMap<u32, Vec<(u32, Chord)>>,
+    vertex_owner: HashMap<u32, u32>,
+}
+
+impl Board {
+    /// `Ok` when `curve` conflicts with no placed cut, else the owners of those it meets.
+    fn fits(
+        &self,
+        mesh: &SurfaceMesh,
+        topology: &Topology,
+        curve: &SectionCurve,
+        gap: f64,
+    ) -> Result<(), Vec<u32>> {
+        let mut blockers: Vec<u32> = curve_vertices(curve)
+            .iter()
+            .filter_map(|v| self.vertex_owner.get(v).copied())
+            .collect();
+        for chord in curve.chords(mesh, topology) {
+            if let Some(others) = self.chords.get(&chord.face) {
+                blockers.extend(
+                    others
+                        .iter()
+                        .filter(|(_, other)| chord.crosses_or_touches(other, gap))
+                        .map(|(owner, _)| *owner),
+                );
+            }
+        }
+        if blockers.is_empty() {
+            Ok(())
+        } else {
+            Err(blockers)
+        }
+    }
+
+    fn place(&mut self, mesh: &SurfaceMesh, topology: &Topology, joint: u32, curve: &SectionCurve) {
+        for chord in curve.chords(mesh, topology) {
+            self.chords
+                .entry(chord.face)
+                .or_default()
+                .push((joint, chord));
+        }
+        self.vertex_owner
+            .extend(curve_vertices(curve).into_iter().map(|v| (v, joint)));
+    }
+
+    fn remove(&mut self, joint: u32) {
+        for list in self.chords.values_mut() {
+            list.retain(|(owner, _)| *owner != joint);
+        }
+        self.vertex_owner.retain(|_, owner| *owner != joint);
+    }
+}
+
+/// The joint's mirror twin, when its plan searches a cut.
+fn mirror_twin(plan: &JointPlan) -> Option<u32> {
+    match plan {
+        JointPlan::Boundary(frame) | JointPlan::CutOrSkip(frame, _) => frame.mirror_twin,
+        _ => None,
+    }
 }
 
 /// The joints that search a cut, in the order of the module documentation: by increasing
@@ -143,7 +218,7 @@ fn placement_order(
 /// candidate or the joints whose cuts blocked every candidate (`None`: it had none).
 fn placement_of(
     plan: &JointPlan,
-    placed: Option<Result<usize, Vec<u32>>>,
+    placed: Option<Search>,
     search: &CutSearch,
     skeleton: &Skeleton,
 ) -> Placement {
@@ -159,7 +234,7 @@ fn placement_of(
         }
         JointPlan::CutOrSkip(frame, reason) => {
             return match placed {
-                Some(Ok(candidate)) => Placement::Cut {
+                Some(Search::Accepted(candidate)) => Placement::Cut {
                     candidate,
                     frame: *frame,
                 },
@@ -169,8 +244,13 @@ fn placement_of(
         JointPlan::Boundary(frame) => *frame,
     };
     let reason = match placed {
-        Some(Ok(candidate)) => return Placement::Cut { candidate, frame },
-        Some(Err(mut blockers)) => {
+        Some(Search::Accepted(candidate)) => return Placement::Cut { candidate, frame },
+        Some(Search::TwinsCross(twin)) => format!(
+            "its closed sections and those of its mirror twin {} cross each other: both are \
+             soft, so that the two sides bend alike",
+            skeleton.names[twin as usize]
+        ),
+        Some(Search::Blocked(mut blockers)) => {
             blockers.sort_unstable();
             blockers.dedup();
             let names: Vec<&str> = blockers
@@ -219,7 +299,7 @@ fn curve_vertices(curve: &SectionCurve) -> Vec<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cuts::plane_section::Plane;
+    use crate::cuts::plane_section::{closed_length, Plane};
     use glam::DVec3;
 
     fn boundary(on_mirror_plane: bool) -> JointPlan {
@@ -230,6 +310,7 @@ mod tests {
             bone_length: 1.0,
             surface_distance: 0.1,
             on_mirror_plane,
+            mirror_twin: None,
         })
     }
 
@@ -280,11 +361,11 @@ mod tests {
         };
         let plan = JointPlan::CutOrSkip(frame, "end site".into());
         let search = CutSearch::default();
-        let blocked = placement_of(&plan, Some(Err(vec![0])), &search, &skeleton);
+        let blocked = placement_of(&plan, Some(Search::Blocked(vec![0])), &search, &skeleton);
         assert_eq!(blocked, Placement::Skip("end site".into()));
         let none = placement_of(&plan, None, &search, &skeleton);
         assert_eq!(none, Placement::Skip("end site".into()));
-        let placed = placement_of(&plan, Some(Ok(2)), &search, &skeleton);
+        let placed = placement_of(&plan, Some(Search::Accepted(2)), &search, &skeleton);
         assert_eq!(
             placed,
             Placement::Cut {
@@ -292,6 +373,86 @@ mod tests {
                 frame
             }
         );
+    }
+
+    /// Mirror twins (joints 1 and 2 of a tube along +Y) whose only sections cross each
+    /// other inside the tube: two planes through its middle tilted ±30° about +Z.
+    fn placements_of_crossing_twins(twins: bool) -> Vec<Placement> {
+        use crate::cuts::plane_section::{vertex_snap_distances, DomainScratch, SectionDomain};
+        use crate::fixtures::shapes::capsule_chain;
+        let ends = [DVec3::ZERO, DVec3::Y];
+        let (mesh, _) = capsule_chain(&ends, &[], 0.2, 16, 8);
+        let topology = Topology::new(&mesh);
+        let snap = vertex_snap_distances(&mesh, &topology, 0.01);
+        let faces: Vec<u32> = (0..mesh.triangle_count() as u32).collect();
+        let mut domain = SectionDomain::new(
+            &mesh,
+            &topology,
+            &snap,
+            faces,
+            &mut DomainScratch::default(),
+        );
+        let middle = 0.5 * DVec3::Y;
+        let mut search = |tilt: f64| {
+            let plane = Plane {
+                point: middle,
+                normal: DVec3::new(tilt.sin(), tilt.cos(), 0.0),
+            };
+            let curve = domain.closed_sections(&plane).remove(0);
+            let points = curve.positions(&mesh, &topology);
+            CutSearch {
+                candidates: vec![CutCandidate {
+                    plane,
+                    perimeter: closed_length(&points),
+                    curve,
+                    points,
+                }],
+                ..CutSearch::default()
+            }
+        };
+        let searches = [
+            CutSearch::default(),
+            search(30f64.to_radians()),
+            search(-30f64.to_radians()),
+        ];
+        let skeleton = Skeleton::from_positions(
+            vec!["root".into(), "left".into(), "right".into()],
+            vec![NO_PARENT, 0, 0],
+            &[glam::Vec3::ZERO, middle.as_vec3(), middle.as_vec3()],
+        )
+        .expect("valid skeleton");
+        let twin_of = |twin: u32| {
+            let JointPlan::Boundary(frame) = boundary(false) else {
+                unreachable!()
+            };
+            JointPlan::Boundary(JointFrame {
+                mirror_twin: twins.then_some(twin),
+                ..frame
+            })
+        };
+        let plans = [JointPlan::Skip("root".into()), twin_of(2), twin_of(1)];
+        place_cuts(&mesh, &topology, &skeleton, &plans, &searches, 0.01)
+    }
+
+    #[test]
+    fn mirror_twins_whose_cuts_cross_are_both_soft() {
+        let soft_reason = |p: &Placement| match p {
+            Placement::Soft { reason, .. } => reason.clone(),
+            other => panic!("expected a soft boundary, got {other:?}"),
+        };
+        let twins = placements_of_crossing_twins(true);
+        assert!(soft_reason(&twins[1]).contains("mirror twin right"));
+        assert!(soft_reason(&twins[2]).contains("mirror twin left"));
+        // Not twins: the first placed keeps its cut and blocks the other.
+        let strangers = placements_of_crossing_twins(false);
+        let cuts = strangers
+            .iter()
+            .filter(|p| matches!(p, Placement::Cut { .. }))
+            .count();
+        assert_eq!(cuts, 1);
+        assert!(strangers[1..]
+            .iter()
+            .any(|p| matches!(p, Placement::Soft { reason, .. } if reason.contains("crosses"))));
     }
 
     #[test]

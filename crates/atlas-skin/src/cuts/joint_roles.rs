@@ -93,6 +93,10 @@ pub struct JointFrame {
     /// A branching joint on the skeleton's mirror plane (pelvis, chest, head): its plane
     /// crosses the trunk where limbs branch, so it is placed after every other cut.
     pub on_mirror_plane: bool,
+    /// The joint at this one's reflection through the mirror plane ([`mirror_twins`]): the
+    /// other side's knee of a knee. Twins whose cuts cross are both soft
+    /// ([`crate::cuts::conflicts`]).
+    pub mirror_twin: Option<u32>,
 }
 
 /// What the decomposition does at one joint.
@@ -153,6 +157,7 @@ pub fn plan_joints(
     overrides: &[Option<Override>],
     params: &DecomposeParams,
 ) -> Vec<JointPlan> {
+    let symmetry = infer_symmetry_plane(skeleton, positions, params.symmetry_tolerance);
     let rig = Rig {
         mesh,
         spheres,
@@ -160,7 +165,8 @@ pub fn plan_joints(
         positions,
         children: skeleton.children(),
         scale: diagonal(positions).max(f64::MIN_POSITIVE),
-        symmetry: infer_symmetry_plane(skeleton, positions, params.symmetry_tolerance),
+        symmetry,
+        twins: mirror_twins(symmetry, positions, params.symmetry_tolerance),
         orientation: orientation_sign(mesh),
         bones,
         params,
@@ -181,6 +187,8 @@ struct Rig<'a> {
     /// Diagonal of the joints' bounding box.
     scale: f64,
     symmetry: Option<SymmetryPlane>,
+    /// [`mirror_twins`] of the joints.
+    twins: Vec<Option<u32>>,
     /// [`orientation_sign`] of the surface.
     orientation: f64,
     /// The skeleton's bones ([`crate::skeleton::bones::joint_pairs`]).
@@ -292,6 +300,7 @@ impl Rig<'_> {
         Some(Bones {
             frame: JointFrame {
                 on_mirror_plane,
+                mirror_twin: self.twins[j],
                 position: p,
                 upper,
                 lower,
@@ -549,6 +558,40 @@ const SYMMETRY_CANDIDATES: usize = 24;
 /// 10,000 sibling joints would give 50 million).
 const SYMMETRY_CANDIDATES_IN_GROUP: usize = 100;
 
+/// Each joint's mirror twin: the other joint nearest to its reflection through `plane`,
+/// when that lies within `tolerance` × the skeleton's diagonal of the reflection (the
+/// tolerance of [`infer_symmetry_plane`]'s fit) and the two are each other's nearest. A
+/// joint on the plane reflects onto itself and has none; so does every joint when there is
+/// no plane. Nearest joints from a grid: O(J log J).
+pub fn mirror_twins(
+    plane: Option<SymmetryPlane>,
+    positions: &[DVec3],
+    tolerance: f64,
+) -> Vec<Option<u32>> {
+    let Some(plane) = plane else {
+        return vec![None; positions.len()];
+    };
+    let reach = tolerance * diagonal(positions);
+    let joints = PointGrid::new(positions);
+    let nearest_to_reflection: Vec<Option<u32>> = positions
+        .iter()
+        .map(|&p| {
+            let mirrored = p - 2.0 * (plane.normal.dot(p) - plane.offset) * plane.normal;
+            joints
+                .nearest(mirrored)
+                .filter(|&(_, distance)| distance <= reach)
+                .map(|(k, _)| k as u32)
+        })
+        .collect();
+    nearest_to_reflection
+        .iter()
+        .enumerate()
+        .map(|(j, &twin)| {
+            twin.filter(|&t| t as usize != j && nearest_to_reflection[t as usize] == Some(j as u32))
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -595,6 +638,28 @@ mod tests {
     }
 
     #[test]
+    fn mirror_twins_of_a_stick_figure_are_its_left_and_right_limbs() {
+        for tilt in [0.0, 0.4] {
+            let (skeleton, positions) = stick_figure(tilt);
+            let plane = infer_symmetry_plane(&skeleton, &positions, 0.02);
+            let twins = mirror_twins(plane, &positions, 0.02);
+            let name = |j: Option<u32>| j.map(|j| skeleton.names[j as usize].as_str());
+            let of = |n: &str| name(twins[skeleton.names.iter().position(|m| m == n).unwrap()]);
+            assert_eq!(of("arm.L"), Some("arm.R"));
+            assert_eq!(of("hand.R"), Some("hand.L"));
+            assert_eq!(of("foot.L"), Some("foot.R"));
+            for on_plane in ["pelvis", "chest", "neck"] {
+                assert_eq!(of(on_plane), None);
+            }
+        }
+        // Without a plane there are no twins.
+        let (_, positions) = stick_figure(0.0);
+        assert!(mirror_twins(None, &positions, 0.02)
+            .iter()
+            .all(Option::is_none));
+    }
+
+    #[test]
     fn a_lopsided_skeleton_has_no_mirror_plane() {
         let (mut skeleton, mut positions) = stick_figure(0.0);
         positions[4] = DVec3::new(0.6, 2.0, 0.5);
@@ -616,6 +681,7 @@ mod tests {
             bone_length: 3.0,
             surface_distance: spheres.nearest_distance(&mesh, position),
             on_mirror_plane: false,
+            mirror_twin: None,
         };
         let ratio = crate::DecomposeParams::default().leaf_extent_ratio;
         leaf_part(

@@ -28,17 +28,29 @@ impl PointGrid {
     /// The smallest `q.distance(p)` over the points (infinity when there are none): the
     /// same value as a scan of every point.
     pub fn nearest_distance(&self, p: DVec3) -> f64 {
+        self.nearest(p)
+            .map_or(f64::INFINITY, |(_, distance)| distance)
+    }
+
+    /// The index of the point nearest to `p` (the first of equals in a scan's order, in the
+    /// grid's order of visits otherwise) and its distance; `None` when there are none.
+    pub fn nearest(&self, p: DVec3) -> Option<(usize, f64)> {
         let distance = |k: u32| self.points[k as usize].distance(p);
-        let mut best = f64::INFINITY;
+        let mut best: Option<(usize, f64)> = None;
+        let mut offer = |k: u32| {
+            let d = distance(k);
+            if best.is_none_or(|(_, b)| d < b) {
+                best = Some((k as usize, d));
+            }
+            best.map_or(f64::INFINITY, |(_, b)| b)
+        };
         if self.points.len() < SCAN_BELOW {
-            return (0..self.points.len() as u32)
-                .map(distance)
-                .fold(best, f64::min);
+            (0..self.points.len() as u32).for_each(|k| {
+                offer(k);
+            });
+        } else {
+            shells(&self.grid, p, &mut offer);
         }
-        shells(&self.grid, p, &mut |k| {
-            best = best.min(distance(k));
-            best
-        });
         best
     }
 }
@@ -84,7 +96,7 @@ mod tests {
     /// Clustered, collinear, coincident and spread points, queried inside and far outside
     /// their box: the same distance as a scan of every point.
     #[test]
-    fn grid_gives_the_scanned_nearest_distance() {
+    fn grid_gives_the_scanned_nearest_point() {
         let mut rng = SplitMix64::new(3);
         let mut random =
             |scale: f64| DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64()) * scale;
@@ -113,6 +125,11 @@ mod tests {
                     .map(|q| q.distance(p))
                     .fold(f64::INFINITY, f64::min);
                 assert_eq!(grid.nearest_distance(p), scanned);
+                let nearest = grid.nearest(p);
+                assert_eq!(nearest.map(|(_, d)| d), points.first().map(|_| scanned));
+                if let Some((k, d)) = nearest {
+                    assert_eq!(points[k].distance(p), d);
+                }
             }
         }
     }
