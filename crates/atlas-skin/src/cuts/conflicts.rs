@@ -18,11 +18,13 @@
 //! other sampled planes, by increasing perimeter); when none fits, it gets a soft boundary:
 //! its plane restricted to the region that holds it (METHOD.md, "extensions"), which the
 //! weights stage blends across; so does a joint that [`crate::cuts::joint_roles`] allows no cut.
-//! Mirror twins are the exception to first come, first served: when every section of a
-//! joint crosses the cut of its mirror twin ([`crate::cuts::joint_roles::mirror_twins`]:
-//! the other thigh of legs modelled as one skirt-like piece), the twin's cut is taken back
-//! and both get soft boundaries, so that the two sides of a symmetric character bend alike
-//! (docs/measurements.md, "Mirror twins whose cuts cross").
+//! Mirror twins are the exception to first come, first served: a joint keeps its cut only
+//! when its mirror twin ([`crate::cuts::joint_roles::mirror_twins`]) gets one too. When a
+//! twin ends without a cut (every section crosses a placed cut, such as the other thigh's
+//! in legs modelled as one skirt-like piece, or no clean closed section exists around it),
+//! the joint is denied its cut and the others are placed again without it, until no twin
+//! is left with a cut whose twin has none: the two sides of a symmetric character bend
+//! alike (docs/measurements.md, "Mirror twins").
 //! A joint is left without a boundary only for the reasons of [`crate::cuts::joint_roles`], or
 //! when no region holds it (an empty surface); the report says which.
 
@@ -45,8 +47,8 @@ enum Search {
     Accepted(usize),
     /// Every candidate conflicts with a placed cut: the joints of those cuts.
     Blocked(Vec<u32>),
-    /// Every candidate conflicts with the cut of this mirror twin: neither keeps a cut.
-    TwinsCross(u32),
+    /// Not placed: this mirror twin gets no cut (module documentation).
+    TwinWithoutCut(u32),
 }
 
 /// Where the conflict rule put a joint's boundary.
@@ -74,9 +76,53 @@ pub fn place_cuts(
     gap: f64,
 ) -> Vec<Placement> {
     let candidates: Vec<&[CutCandidate]> = searches.iter().map(|s| &s.candidates[..]).collect();
+    let order = placement_order(plans, &candidates, &skeleton.parents);
+    // Joints denied a cut because their mirror twin gets none. The set only grows, so the
+    // passes end; each pass places the others again without the denied joints' cuts.
+    let mut denied: Vec<Option<u32>> = vec![None; plans.len()];
+    let placed = loop {
+        let placed = place_in_order(mesh, topology, &order, &candidates, &denied, gap);
+        let mut grew = false;
+        for (j, plan) in plans.iter().enumerate() {
+            let Some(twin) = mirror_twin(plan) else {
+                continue;
+            };
+            let without_cut = !matches!(placed[j], Some(Search::Accepted(_)));
+            if without_cut && matches!(placed[twin as usize], Some(Search::Accepted(_))) {
+                denied[twin as usize] = Some(j as u32);
+                grew = true;
+            }
+        }
+        if !grew {
+            break placed;
+        }
+    };
+    plans
+        .iter()
+        .zip(placed)
+        .zip(searches)
+        .map(|((plan, placed), search)| placement_of(plan, placed, search, skeleton))
+        .collect()
+}
+
+/// One pass of the conflict rule: the joints of `order` in turn take their first candidate
+/// that conflicts with no cut placed before, except the `denied` ones (their twin's index).
+/// `None` for the joints that are not in `order`.
+fn place_in_order(
+    mesh: &SurfaceMesh,
+    topology: &Topology,
+    order: &[usize],
+    candidates: &[&[CutCandidate]],
+    denied: &[Option<u32>],
+    gap: f64,
+) -> Vec<Option<Search>> {
     let mut board = Board::default();
-    let mut placed: Vec<Option<Search>> = vec![None; plans.len()];
-    for j in placement_order(plans, &candidates, &skeleton.parents) {
+    let mut placed: Vec<Option<Search>> = vec![None; candidates.len()];
+    for &j in order {
+        if let Some(twin) = denied[j] {
+            placed[j] = Some(Search::TwinWithoutCut(twin));
+            continue;
+        }
         let mut blockers: Vec<u32> = Vec::new();
         let accepted = candidates[j].iter().position(|candidate| {
             match board.fits(mesh, topology, &candidate.curve, gap) {
@@ -92,25 +138,10 @@ pub fn place_cuts(
                 board.place(mesh, topology, j as u32, &candidates[j][k].curve);
                 Search::Accepted(k)
             }
-            None => match mirror_twin(&plans[j]) {
-                Some(twin)
-                    if blockers.contains(&twin)
-                        && matches!(placed[twin as usize], Some(Search::Accepted(_))) =>
-                {
-                    board.remove(twin);
-                    placed[twin as usize] = Some(Search::TwinsCross(j as u32));
-                    Search::TwinsCross(twin)
-                }
-                _ => Search::Blocked(blockers),
-            },
+            None => Search::Blocked(blockers),
         });
     }
-    plans
-        .iter()
-        .zip(placed)
-        .zip(searches)
-        .map(|((plan, placed), search)| placement_of(plan, placed, search, skeleton))
-        .collect()
+    placed
 }
 
 /// The cuts placed so far: their chords by face and the vertices they run through.
@@ -159,13 +190,6 @@ impl Board {
         }
         self.vertex_owner
             .extend(curve_vertices(curve).into_iter().map(|v| (v, joint)));
-    }
-
-    fn remove(&mut self, joint: u32) {
-        for list in self.chords.values_mut() {
-            list.retain(|(owner, _)| *owner != joint);
-        }
-        self.vertex_owner.retain(|_, owner| *owner != joint);
     }
 }
 
@@ -238,6 +262,10 @@ fn placement_of(
                     candidate,
                     frame: *frame,
                 },
+                Some(Search::TwinWithoutCut(twin)) => Placement::Skip(format!(
+                    "{reason}; its mirror twin {} gets no cut",
+                    skeleton.names[twin as usize]
+                )),
                 _ => Placement::Skip(reason.clone()),
             }
         }
@@ -245,9 +273,8 @@ fn placement_of(
     };
     let reason = match placed {
         Some(Search::Accepted(candidate)) => return Placement::Cut { candidate, frame },
-        Some(Search::TwinsCross(twin)) => format!(
-            "its closed sections and those of its mirror twin {} cross each other: both are \
-             soft, so that the two sides bend alike",
+        Some(Search::TwinWithoutCut(twin)) => format!(
+            "its mirror twin {} gets no cut: neither does it, so that the two sides bend alike",
             skeleton.names[twin as usize]
         ),
         Some(Search::Blocked(mut blockers)) => {
@@ -376,8 +403,9 @@ mod tests {
     }
 
     /// Mirror twins (joints 1 and 2 of a tube along +Y) whose only sections cross each
-    /// other inside the tube: two planes through its middle tilted ±30° about +Z.
-    fn placements_of_crossing_twins(twins: bool) -> Vec<Placement> {
+    /// other inside the tube: two planes through its middle tilted ±30° about +Z; without
+    /// `right_section` the second joint has none.
+    fn placements_of_crossing_twins(twins: bool, right_section: bool) -> Vec<Placement> {
         use crate::cuts::plane_section::{vertex_snap_distances, DomainScratch, SectionDomain};
         use crate::fixtures::shapes::capsule_chain;
         let ends = [DVec3::ZERO, DVec3::Y];
@@ -410,10 +438,16 @@ mod tests {
                 ..CutSearch::default()
             }
         };
+        let left = search(30f64.to_radians());
+        let right = search(-30f64.to_radians());
         let searches = [
             CutSearch::default(),
-            search(30f64.to_radians()),
-            search(-30f64.to_radians()),
+            left,
+            if right_section {
+                right
+            } else {
+                CutSearch::default()
+            },
         ];
         let skeleton = Skeleton::from_positions(
             vec!["root".into(), "left".into(), "right".into()],
@@ -435,16 +469,20 @@ mod tests {
     }
 
     #[test]
-    fn mirror_twins_whose_cuts_cross_are_both_soft() {
+    fn a_joint_keeps_its_cut_only_when_its_mirror_twin_gets_one() {
         let soft_reason = |p: &Placement| match p {
             Placement::Soft { reason, .. } => reason.clone(),
             other => panic!("expected a soft boundary, got {other:?}"),
         };
-        let twins = placements_of_crossing_twins(true);
+        let twins = placements_of_crossing_twins(true, true);
         assert!(soft_reason(&twins[1]).contains("mirror twin right"));
         assert!(soft_reason(&twins[2]).contains("mirror twin left"));
+        // A twin without any section: the other is denied its cut.
+        let lone = placements_of_crossing_twins(true, false);
+        assert!(soft_reason(&lone[1]).contains("mirror twin right gets no cut"));
+        assert!(soft_reason(&lone[2]).contains("no closed cross-section"));
         // Not twins: the first placed keeps its cut and blocks the other.
-        let strangers = placements_of_crossing_twins(false);
+        let strangers = placements_of_crossing_twins(false, true);
         let cuts = strangers
             .iter()
             .filter(|p| matches!(p, Placement::Cut { .. }))

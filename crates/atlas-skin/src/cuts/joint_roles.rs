@@ -94,7 +94,7 @@ pub struct JointFrame {
     /// crosses the trunk where limbs branch, so it is placed after every other cut.
     pub on_mirror_plane: bool,
     /// The joint at this one's reflection through the mirror plane ([`mirror_twins`]): the
-    /// other side's knee of a knee. Twins whose cuts cross are both soft
+    /// other side's knee of a knee. A joint keeps its cut only when its twin gets one
     /// ([`crate::cuts::conflicts`]).
     pub mirror_twin: Option<u32>,
 }
