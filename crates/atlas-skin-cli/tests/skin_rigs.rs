@@ -70,9 +70,12 @@ fn joints_without_parent_links_get_an_inferred_tree_and_the_nodes_stay() {
         "the file's nodes are unchanged"
     );
     let cuts = |r: &Value| r["decomposition"]["cuts"].as_u64().unwrap();
-    // Measured: 14 cuts from the inferred tree, 15 from the file's links.
+    // Measured: 13 cuts from the inferred tree, 15 from the file's links. In the inferred
+    // tree every section of one ankle (node9) crosses the cut of its foot, and the other
+    // ankle, its mirror twin, gives up its cut with it (`cuts::conflicts`); before that
+    // rule, 14.
     assert!(
-        cuts(&report) + 1 >= cuts(&linked),
+        cuts(&report) + 2 >= cuts(&linked),
         "{} vs {}",
         cuts(&report),
         cuts(&linked)
