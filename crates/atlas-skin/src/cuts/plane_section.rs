@@ -517,7 +517,7 @@ impl ChainDomain for SectionDomain {
 /// (and kept there for the query), and the edges a query visits are stamped there too. Building one is a pass over its faces'
 /// corners (their box and largest snap distance), where a [`SectionDomain`] costs about
 /// 315 instructions a face (on makehuman) for local arrays that such a query barely reads;
-/// the tracing is the same ([`ChainDomain`]).
+/// the tracing is the same (the trait `ChainDomain`).
 #[derive(Debug)]
 pub struct NearRayDomain<'a> {
     mesh: &'a SurfaceMesh,
