@@ -86,6 +86,28 @@ impl<'a> Iterator for Words<'a> {
     }
 }
 
+/// The lines of `text` ([`str::lines`]), each cut at its first `comment` character: the
+/// same as `line.split(comment).next()` line by line, but the comment characters are
+/// found by a search through the text that starts again only at the line after one (a
+/// search per line cost about 145 instructions, 8.6 M on makehuman's OBJ of 59,167 lines
+/// of which 16 hold a comment).
+pub(crate) fn uncommented_lines(text: &str, comment: char) -> impl Iterator<Item = &str> {
+    // The first comment character at or after the start of the line before (or of the
+    // text).
+    let mut next_comment = text.find(comment);
+    text.lines().map(move |line| {
+        // The line's place in the text, of which it is a slice.
+        let start = line.as_ptr() as usize - text.as_ptr() as usize;
+        if next_comment.is_some_and(|at| at < start) {
+            next_comment = text[start..].find(comment).map(|k| start + k);
+        }
+        match next_comment {
+            Some(at) if at < start + line.len() => &line[..at - start],
+            _ => line,
+        }
+    })
+}
+
 /// Parses the JSON document at `path` into `T`; syntax and shape errors carry the line.
 pub(crate) fn read_json<T: DeserializeOwned>(path: &Path) -> Result<T, IoError> {
     let text = read_text(path)?;
@@ -292,6 +314,32 @@ mod tests {
             error.contains("unexpected end of file, expected z"),
             "{error}"
         );
+    }
+
+    /// Lines cut at their comments as line by line: comments at the start, in the middle
+    /// and at the end of lines, several on a line and on consecutive lines, empty lines,
+    /// "\r\n" endings, a last line without an ending, other characters and a text without
+    /// comments.
+    #[test]
+    fn uncommented_lines_are_the_lines_cut_one_by_one() {
+        let texts = [
+            "",
+            "#",
+            "\n\n#\n",
+            "v 1 2 3\nf 1 2 3",
+            "# header ## more\n#\nv 1 2 3 # tail\r\nv 4#5 6\n\nf 1/1 2/2 3/3#\n# last",
+            "é #ü\r\n\r\nß#\n##\n x",
+        ];
+        for text in texts {
+            for comment in ['#', 'ü', '/'] {
+                let expected: Vec<&str> = text
+                    .lines()
+                    .map(|line| line.split(comment).next().unwrap_or_default())
+                    .collect();
+                let found: Vec<&str> = uncommented_lines(text, comment).collect();
+                assert_eq!(found, expected, "{text:?} cut at {comment:?}");
+            }
+        }
     }
 
     #[test]

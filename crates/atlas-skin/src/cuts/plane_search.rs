@@ -13,7 +13,7 @@
 //! `neighbourhood_factor` × max(surface distance, bone length / 10), gathered once per joint,
 //! doubled up to twice when it holds no closed section around J); a curve reaching the
 //! border of that set is not closed and is discarded. Of the closed
-//! curves (only those that can contain J are traced: `SectionDomain::sections_around`),
+//! curves (only those that can contain J are traced: `JointSections::sections_around`),
 //! the one whose interior in the plane contains J is kept — unless another bone of
 //! the skeleton (one not at J) passes through that interior: such a plane slices a torso
 //! or a palm across other limbs, not the limb at J — and the plane of minimum perimeter F
@@ -22,7 +22,7 @@
 use super::params::DecomposeParams;
 use crate::cuts::joint_roles::JointFrame;
 use crate::cuts::plane_section::{
-    closed_length, polygon_contains, DomainScratch, Plane, SectionCurve, SectionDomain,
+    closed_length, polygon_contains, DomainScratch, JointSections, Plane, SectionCurve,
 };
 use crate::mesh::spatial_index::FaceSpheres;
 use crate::mesh::{SurfaceMesh, Topology};
@@ -187,7 +187,7 @@ fn search_within(
         other_bones,
         enclosing_other_bones: 0,
         position: frame.position,
-        domain: SectionDomain::new(mesh, topology, surface.vertex_snap, faces, scratch),
+        domain: JointSections::new(mesh, topology, surface.vertex_snap, faces, scratch),
         basis: NormalBasis::new(frame.upper, frame.lower),
         evaluated: Vec::new(),
     };
@@ -336,7 +336,7 @@ struct PlaneSearch<'a> {
     /// Count of sections around J turned down for enclosing another bone.
     enclosing_other_bones: usize,
     position: DVec3,
-    domain: SectionDomain,
+    domain: JointSections<'a>,
     basis: NormalBasis,
     /// Every plane evaluated, by the bits of its normal: its outcome and how many sections
     /// it turned down for enclosing another bone.
@@ -435,20 +435,25 @@ mod tests {
             joint + 0.05 * DVec3::X + 0.1 * DVec3::Y,
         ]];
         let faces: Vec<u32> = (0..mesh.triangle_count() as u32).collect();
-        let mut scratch = DomainScratch::default();
+        let (mut scratch, mut other_scratch) = (DomainScratch::default(), DomainScratch::default());
         for other_bones in [&[][..], &through[..]] {
-            let mut new_search = || PlaneSearch {
+            let new_search = |domain| PlaneSearch {
                 mesh: &mesh,
                 topology: &topology,
                 spheres: &spheres,
                 other_bones,
                 enclosing_other_bones: 0,
                 position: joint,
-                domain: SectionDomain::new(&mesh, &topology, &snap, faces.clone(), &mut scratch),
+                domain,
                 basis: NormalBasis::new(DVec3::Y, DVec3::new(0.6f64.sin(), 0.6f64.cos(), 0.0)),
                 evaluated: Vec::new(),
             };
-            let (mut reused, mut computed) = (new_search(), new_search());
+            let domain =
+                |scratch| JointSections::new(&mesh, &topology, &snap, faces.clone(), scratch);
+            let (mut reused, mut computed) = (
+                new_search(domain(&mut scratch)),
+                new_search(domain(&mut other_scratch)),
+            );
             let h = 5f64.to_radians();
             let samples = reused.basis.coarse_samples(2.0 * h, 30f64.to_radians());
             let mut found = 0;

@@ -79,9 +79,9 @@ pub struct Chord {
 /// query. Everything is indexed locally (vertices, edges and faces of the domain), so that
 /// building a domain costs O(its faces), not O(the mesh), and a query touches only the
 /// domain's own arrays: it computes the signed distance and side of the domain's vertices
-/// and scans its faces ([`SectionDomain::closed_sections`]), or takes the faces near one
-/// ray from the mesh's face hierarchy ([`SectionDomain::sections_around`]); only crossed
-/// faces are traced, through each local edge's faces across.
+/// and scans its faces ([`SectionDomain::closed_sections`]); only crossed faces are traced,
+/// through each local edge's faces across. (A large domain asked only for the sections
+/// around a point is a [`NearRayDomain`], which builds none of this.)
 #[derive(Debug, Clone)]
 pub struct SectionDomain {
     /// Per local face: its face of the mesh, its corners and its edges (in the order of
@@ -108,15 +108,111 @@ pub struct SectionDomain {
     stamp: u32,
     /// The local faces a query crosses, in order (a buffer reused by every query).
     crossed_faces: Vec<u32>,
-    /// The box of the domain's vertices and their largest snap distance (what
-    /// [`Self::sections_around`] bounds its segment by).
-    bounds: [DVec3; 2],
-    max_snap: f64,
-    /// The mesh faces near a query's segment (a buffer reused by every query).
-    segment_faces: Vec<u32>,
-    /// The chain being traced: its crossings and faces (buffers reused by every trace).
-    chain_crossings: Vec<EdgeCrossing>,
-    chain_faces: Vec<u32>,
+    chain: Chain,
+}
+
+/// The chain being traced: its crossings and faces (buffers reused by every trace).
+#[derive(Debug, Clone, Default)]
+struct Chain {
+    crossings: Vec<EdgeCrossing>,
+    faces: Vec<u32>,
+}
+
+/// What tracing a chain needs of a domain, its faces and edges indexed its own way (local
+/// indices in a [`SectionDomain`], the mesh's in a [`NearRayDomain`]), for the plane of the
+/// current query: one tracing for both.
+trait ChainDomain {
+    /// The edges of face `face`, in the order of [`Topology::face_edges`].
+    fn face_edges(&self, face: u32) -> [u32; 3];
+    /// Whether edge `e` has its ends on different sides.
+    fn is_crossed(&mut self, e: u32) -> bool;
+    fn crossing(&mut self, e: u32) -> EdgeCrossing;
+    /// The face across edge `e` from `from`, if `e` is manifold and both its faces are in
+    /// the domain (the first of them when there is no `from`).
+    fn face_across(&self, e: u32, from: Option<u32>) -> Option<u32>;
+    /// The mesh's index of face `face`.
+    fn mesh_face(&self, face: u32) -> u32;
+    /// Whether the current query has visited edge `e`.
+    fn visited(&self, e: u32) -> bool;
+    fn visit(&mut self, e: u32);
+    fn chain(&mut self) -> &mut Chain;
+
+    /// Traces from each crossed edge of crossed face `face` not yet visited by this query,
+    /// adding the closed curves to `curves`.
+    fn trace_from_face(&mut self, face: u32, curves: &mut Vec<SectionCurve>) {
+        for e in self.face_edges(face) {
+            if !self.visited(e) && self.is_crossed(e) {
+                let mut chain = std::mem::take(self.chain());
+                let curve = self.trace(e, &mut chain);
+                *self.chain() = chain;
+                if let Some(curve) = curve {
+                    curves.push(curve);
+                }
+            }
+        }
+    }
+
+    /// Follows the chain from crossed edge `start`; `Some` when it closes on `start`.
+    fn trace(&mut self, start: u32, chain: &mut Chain) -> Option<SectionCurve> {
+        self.visit(start);
+        // The chain grows in buffers reused by every trace; a closed one is copied out at
+        // its length (most chains of a query leave the domain and are dropped).
+        let first = self.crossing(start);
+        chain.crossings.clear();
+        chain.crossings.push(first);
+        chain.faces.clear();
+        let (mut edge, mut from) = (start, None);
+        loop {
+            let face = self.face_across(edge, from)?;
+            let mut others = self
+                .face_edges(face)
+                .into_iter()
+                .filter(|&g| g != edge && self.is_crossed(g));
+            let next = others.next()?;
+            if others.next().is_some() {
+                return None;
+            }
+            chain.faces.push(self.mesh_face(face));
+            if next == start {
+                return Some(SectionCurve {
+                    crossings: chain.crossings.clone(),
+                    faces: chain.faces.clone(),
+                });
+            }
+            if self.visited(next) {
+                return None;
+            }
+            self.visit(next);
+            let crossing = self.crossing(next);
+            chain.crossings.push(crossing);
+            (edge, from) = (next, Some(face));
+        }
+    }
+}
+
+/// Where a chain crosses the edge with ends `a`, `b` (mesh vertices) at snapped signed
+/// distances `da`, `db` (see the sign rule above).
+#[inline(always)]
+fn crossing_point(a: u32, b: u32, da: f64, db: f64) -> CrossingPoint {
+    if da == 0.0 {
+        CrossingPoint::Vertex(a)
+    } else if db == 0.0 {
+        CrossingPoint::Vertex(b)
+    } else {
+        CrossingPoint::Interior(da / (da - db))
+    }
+}
+
+/// The signed distance of a vertex at `p` with snap distance `snap` to `plane`, snapped to
+/// 0 (the sign rule above).
+#[inline(always)]
+fn snapped_distance(plane: &Plane, p: DVec3, snap: f64) -> f64 {
+    let signed = plane.signed_distance(p);
+    if signed.abs() < snap {
+        0.0
+    } else {
+        signed
+    }
 }
 
 /// Whether the plane crosses a face: 1 or 2 of its corners on the non-negative side
@@ -129,17 +225,30 @@ fn face_crossed(side: &[u8], [a, b, c]: [u32; 3]) -> bool {
 /// Below this many faces a domain's scan (about 13 instructions a face, and the tracing of
 /// every section) costs less than the descent of the face hierarchy along a segment (60 to
 /// 80 boxes of about 120 instructions on the benchmark's characters) and the rotation of
-/// the curves it finds (measured: 350, 500, 800 and 1,200 faces; 500 did least work).
+/// the curves it finds (measured: 350, 500, 800 and 1,200 faces; 500 did least work). With
+/// the larger domains built as [`NearRayDomain`]s, 250 and 350 did the same work as 500
+/// to within 0.5%.
 const SEGMENT_QUERY_FACES: usize = 500;
 
 /// Maps from the mesh's vertices, edges and faces to a domain's (0, or 1 + the local
 /// index) used while building a [`SectionDomain`]: allocated once per thread for the whole
 /// mesh and cleared entry by entry, so that a domain costs O(its faces).
+///
+/// A [`NearRayDomain`] uses more maps: the mark of the domain that last held each face,
+/// the stamp of the query that last visited each edge, and of the query that last computed
+/// each vertex's snapped signed distance (kept beside), with the last mark and stamp given
+/// (numbers that only grow, so that no map is cleared but when they wrap).
 #[derive(Debug, Clone, Default)]
 pub struct DomainScratch {
     vertex: Vec<u32>,
     edge: Vec<u32>,
     face: Vec<u32>,
+    face_domain: Vec<u32>,
+    edge_query: Vec<u32>,
+    vertex_query: Vec<u32>,
+    vertex_distance: Vec<f64>,
+    domain: u32,
+    query: u32,
 }
 
 impl DomainScratch {
@@ -154,6 +263,46 @@ impl DomainScratch {
             if map.len() < n {
                 *map = vec![0; n];
             }
+        }
+    }
+
+    /// Grows the maps of a [`NearRayDomain`] to the mesh's sizes (new entries hold no mark
+    /// and no stamp: 0).
+    fn fit_marks(&mut self, mesh: &SurfaceMesh, topology: &Topology) {
+        let (faces, edges, vertices) = (
+            mesh.triangle_count(),
+            topology.edges.len(),
+            mesh.vertex_count(),
+        );
+        if self.face_domain.len() < faces {
+            self.face_domain.resize(faces, 0);
+        }
+        if self.edge_query.len() < edges {
+            self.edge_query.resize(edges, 0);
+        }
+        if self.vertex_query.len() < vertices {
+            self.vertex_query.resize(vertices, 0);
+            self.vertex_distance.resize(vertices, 0.0);
+        }
+    }
+
+    /// A new domain's mark (never 0).
+    fn next_domain(&mut self) -> u32 {
+        self.domain = self.domain.wrapping_add(1);
+        if self.domain == 0 {
+            self.face_domain.fill(0);
+            self.domain = 1;
+        }
+        self.domain
+    }
+
+    /// A new query's stamp (never 0).
+    fn next_query(&mut self) {
+        self.query = self.query.wrapping_add(1);
+        if self.query == 0 {
+            self.edge_query.fill(0);
+            self.vertex_query.fill(0);
+            self.query = 1;
         }
     }
 }
@@ -182,18 +331,13 @@ impl SectionDomain {
         faces: Vec<u32>,
         scratch: &mut DomainScratch,
     ) -> Self {
-        let faces: Vec<u32> = faces
-            .into_iter()
-            .filter(|&f| {
-                let [a, b, c] = mesh.triangles[f as usize];
-                a != b && b != c && a != c
-            })
-            .collect();
+        let faces = proper_faces(mesh, faces);
         scratch.fit(mesh, topology);
         let DomainScratch {
             vertex: local_vertex_of,
             edge: local_edge_of,
             face: local_face_of,
+            ..
         } = scratch;
         // At most three of each per face: the lists never grow.
         let mut vertices = Vec::with_capacity(3 * faces.len());
@@ -260,13 +404,6 @@ impl SectionDomain {
             faces,
             local_faces,
             local_face_edges,
-            bounds: local_positions
-                .iter()
-                .fold([DVec3::INFINITY, DVec3::NEG_INFINITY], |[lo, hi], &p| {
-                    [lo.min(p), hi.max(p)]
-                }),
-            max_snap: local_snap.iter().copied().fold(0.0, f64::max),
-            segment_faces: Vec::new(),
             local_positions,
             local_snap,
             local_distance: vec![0.0; vertices.len()],
@@ -278,8 +415,7 @@ impl SectionDomain {
             edge_faces,
             stamp: 0,
             crossed_faces: Vec::new(),
-            chain_crossings: Vec::new(),
-            chain_faces: Vec::new(),
+            chain: Chain::default(),
         }
     }
 
@@ -306,37 +442,164 @@ impl SectionDomain {
         curves
     }
 
-    /// The closed sections of [`Self::closed_sections`] that can contain the plane's point
-    /// (every one that [`polygon_contains`] of `plane.normal` and `plane.point` accepts,
-    /// and perhaps others), each as that list has it (the same crossings from the same
-    /// start), in its order. The domain's faces must be in increasing order (those of
-    /// [`FaceSpheres::faces_near`]); `spheres` indexes the mesh.
+    /// Computes every vertex's signed distance and side for `plane` and starts a new stamp.
+    fn classify(&mut self, plane: &Plane) {
+        for ((d, side), (p, snap)) in self
+            .local_distance
+            .iter_mut()
+            .zip(&mut self.local_side)
+            .zip(self.local_positions.iter().zip(&self.local_snap))
+        {
+            *d = snapped_distance(plane, *p, *snap);
+            *side = u8::from(*d >= 0.0);
+        }
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            self.edge_stamp.fill(0);
+            self.stamp = 1;
+        }
+    }
+}
+
+impl ChainDomain for SectionDomain {
+    fn face_edges(&self, face: u32) -> [u32; 3] {
+        self.local_face_edges[face as usize]
+    }
+
+    fn is_crossed(&mut self, e: u32) -> bool {
+        let [a, b] = self.edge_ends[e as usize];
+        self.local_side[a as usize] != self.local_side[b as usize]
+    }
+
+    fn crossing(&mut self, e: u32) -> EdgeCrossing {
+        let [a, b] = self.edge_ends[e as usize];
+        EdgeCrossing {
+            edge: self.edges[e as usize],
+            point: crossing_point(
+                self.vertices[a as usize],
+                self.vertices[b as usize],
+                self.local_distance[a as usize],
+                self.local_distance[b as usize],
+            ),
+        }
+    }
+
+    fn face_across(&self, e: u32, from: Option<u32>) -> Option<u32> {
+        let faces = self.edge_faces[e as usize]?;
+        match from {
+            Some(g) if faces[0] == g => Some(faces[1]),
+            _ => Some(faces[0]),
+        }
+    }
+
+    fn mesh_face(&self, face: u32) -> u32 {
+        self.faces[face as usize]
+    }
+
+    fn visited(&self, e: u32) -> bool {
+        self.edge_stamp[e as usize] == self.stamp
+    }
+
+    fn visit(&mut self, e: u32) {
+        self.edge_stamp[e as usize] = self.stamp;
+    }
+
+    fn chain(&mut self) -> &mut Chain {
+        &mut self.chain
+    }
+}
+
+/// The faces near one joint, asked only for the closed sections around the joint's point
+/// ([`NearRayDomain::sections_around`]): a large domain, of which a plane's query traces
+/// the few crossed faces near one ray. Nothing is indexed locally: the faces are marked in
+/// the mesh-sized maps of [`DomainScratch`] (by a number per domain, so that nothing is
+/// cleared), a vertex's signed distance is computed when a query's tracing first reads it
+/// (and kept there for the query), and the edges a query visits are stamped there too. Building one is a pass over its faces'
+/// corners (their box and largest snap distance), where a [`SectionDomain`] costs about
+/// 315 instructions a face (on makehuman) for local arrays that such a query barely reads;
+/// the tracing is the same (the trait `ChainDomain`).
+#[derive(Debug)]
+pub struct NearRayDomain<'a> {
+    mesh: &'a SurfaceMesh,
+    topology: &'a Topology,
+    vertex_snap: &'a [f64],
+    scratch: &'a mut DomainScratch,
+    /// This domain's mark in `scratch.face_domain`.
+    mark: u32,
+    /// The plane of the current query.
+    plane: Plane,
+    /// The box of the domain's vertices and their largest snap distance (what
+    /// [`Self::sections_around`] bounds its segment by).
+    bounds: [DVec3; 2],
+    max_snap: f64,
+    /// The mesh faces near a query's segment (a buffer reused by every query).
+    segment_faces: Vec<u32>,
+    chain: Chain,
+}
+
+impl<'a> NearRayDomain<'a> {
+    /// A domain of `faces` of `mesh` (none with a repeated vertex index).
+    fn new(
+        mesh: &'a SurfaceMesh,
+        topology: &'a Topology,
+        vertex_snap: &'a [f64],
+        faces: &[u32],
+        scratch: &'a mut DomainScratch,
+    ) -> Self {
+        scratch.fit_marks(mesh, topology);
+        let mark = scratch.next_domain();
+        // Plain comparisons, not `f64::min` and `max` (which handle NaN, at several
+        // instructions each): the coordinates and snap distances are finite, and a zero's
+        // sign in the box changes nothing the box is used for.
+        let (mut lo, mut hi, mut max_snap) = (DVec3::INFINITY, DVec3::NEG_INFINITY, 0.0f64);
+        for &f in faces {
+            scratch.face_domain[f as usize] = mark;
+            let [a, b, c] = mesh.triangles[f as usize];
+            for v in [a, b, c] {
+                let p = mesh.positions[v as usize];
+                let below = |x: f64, y: f64| if x < y { x } else { y };
+                let above = |x: f64, y: f64| if x > y { x } else { y };
+                lo = DVec3::new(below(p.x, lo.x), below(p.y, lo.y), below(p.z, lo.z));
+                hi = DVec3::new(above(p.x, hi.x), above(p.y, hi.y), above(p.z, hi.z));
+                max_snap = above(vertex_snap[v as usize], max_snap);
+            }
+        }
+        Self {
+            mesh,
+            topology,
+            vertex_snap,
+            scratch,
+            mark,
+            plane: Plane {
+                point: DVec3::ZERO,
+                normal: DVec3::Z,
+            },
+            bounds: [lo, hi],
+            max_snap,
+            segment_faces: Vec::new(),
+            chain: Chain::default(),
+        }
+    }
+
+    /// The closed sections that can contain the plane's point, as
+    /// [`JointSections::sections_around`] gives them, through the faces near the ray of
+    /// [`polygon_contains`].
     ///
-    /// Why a superset: with (u, w) the plane's axes of [`polygon_contains`], a curve
+    /// Why they are all there: with (u, w) the plane's axes of [`polygon_contains`], a curve
     /// containing o = `plane.point` has a segment q₀q₁ that its test sees crossing the ray
     /// o + s·u, s > 0, so a point q of the segment (of one face) has |(q − o)·w| ≤ δ and
     /// (q − o)·u ≥ −δ for the test's rounding δ, and |(q − o)·n| ≤ ε_max + δ (a crossing
     /// at a snapped vertex is off the plane by less than its snap distance ε_v): the face
     /// comes within ε_max + 3δ of the segment from o along u to where the ray leaves the
-    /// domain's box grown by that much. Only the faces near that segment (from the hierarchy of `spheres`)
-    /// and crossed are traced; δ is taken as 10⁻⁹ of the coordinates' size, far above the
-    /// rounding of a few units in the last place. A closed curve is the same from any of
-    /// its edges but for where it starts: [`Self::closed_sections`] reaches it first at its
-    /// lowest face, from that face's first crossed edge, which is where it is rotated to.
-    ///
-    /// A domain of fewer than `SEGMENT_QUERY_FACES` (500) faces is scanned whole instead (its
-    /// closed sections are all listed).
+    /// domain's box grown by that much. Only the faces near that segment (from the hierarchy
+    /// of `spheres`) and crossed are traced; δ is taken as 10⁻⁹ of the coordinates' size,
+    /// far above the rounding of a few units in the last place. A closed curve is the same
+    /// from any of its edges but for where it starts: [`SectionDomain::closed_sections`]
+    /// reaches it first at its lowest face, from that face's first crossed edge, which is
+    /// where it is rotated to.
     pub fn sections_around(&mut self, plane: &Plane, spheres: &FaceSpheres) -> Vec<SectionCurve> {
-        if self.faces.len() < SEGMENT_QUERY_FACES {
-            self.closed_sections(plane)
-        } else {
-            self.sections_near_ray(plane, spheres)
-        }
-    }
-
-    /// [`Self::sections_around`] through the faces near the ray of [`polygon_contains`].
-    fn sections_near_ray(&mut self, plane: &Plane, spheres: &FaceSpheres) -> Vec<SectionCurve> {
-        self.classify(plane);
+        self.plane = *plane;
+        self.scratch.next_query();
         let o = plane.point;
         let (u, _) = plane.normal.any_orthonormal_pair();
         let [lo, hi] = self.bounds;
@@ -358,10 +621,8 @@ impl SectionDomain {
         }
         let mut curves = Vec::new();
         for &f in &near {
-            if let Ok(i) = self.faces.binary_search(&f) {
-                if face_crossed(&self.local_side, self.local_faces[i]) {
-                    self.trace_from_face(i as u32, &mut curves);
-                }
+            if self.holds(f) && self.face_crossed(f) {
+                self.trace_from_face(f, &mut curves);
             }
         }
         self.segment_faces = near;
@@ -373,67 +634,64 @@ impl SectionDomain {
         ordered.into_iter().map(|(_, curve)| curve).collect()
     }
 
-    /// Computes every vertex's signed distance and side for `plane` and starts a new stamp.
-    fn classify(&mut self, plane: &Plane) {
-        for ((d, side), (p, snap)) in self
-            .local_distance
-            .iter_mut()
-            .zip(&mut self.local_side)
-            .zip(self.local_positions.iter().zip(&self.local_snap))
-        {
-            let signed = plane.signed_distance(*p);
-            *d = if signed.abs() < *snap { 0.0 } else { signed };
-            *side = u8::from(*d >= 0.0);
-        }
-        self.stamp = self.stamp.wrapping_add(1);
-        if self.stamp == 0 {
-            self.edge_stamp.fill(0);
-            self.stamp = 1;
-        }
+    /// Whether face `f` of the mesh is in the domain.
+    fn holds(&self, f: u32) -> bool {
+        self.scratch.face_domain[f as usize] == self.mark
     }
 
-    /// Traces from each crossed edge of crossed local face `i` not yet visited by this
-    /// query, adding the closed curves to `curves`.
-    fn trace_from_face(&mut self, i: u32, curves: &mut Vec<SectionCurve>) {
-        for e in self.local_face_edges[i as usize] {
-            if self.edge_stamp[e as usize] != self.stamp && self.is_crossed(e) {
-                if let Some(curve) = self.trace(e) {
-                    curves.push(curve);
-                }
-            }
+    /// The snapped signed distance of vertex `v` to the current plane, computed once per
+    /// query.
+    fn distance(&mut self, v: u32) -> f64 {
+        let v = v as usize;
+        let scratch = &mut *self.scratch;
+        if scratch.vertex_query[v] != scratch.query {
+            scratch.vertex_query[v] = scratch.query;
+            scratch.vertex_distance[v] =
+                snapped_distance(&self.plane, self.mesh.positions[v], self.vertex_snap[v]);
         }
+        scratch.vertex_distance[v]
+    }
+
+    /// 1 when vertex `v` is on the plane or its positive side, else 0.
+    fn side(&mut self, v: u32) -> u8 {
+        u8::from(self.distance(v) >= 0.0)
+    }
+
+    /// Whether the current plane crosses face `f` ([`face_crossed`]).
+    fn face_crossed(&mut self, f: u32) -> bool {
+        let [a, b, c] = self.mesh.triangles[f as usize];
+        (self.side(a) + self.side(b) + self.side(c)).wrapping_sub(1) < 2
     }
 
     /// A closed `curve` traced from any of its edges, started where
-    /// [`Self::closed_sections`] starts it (the first crossed edge of its lowest face, into
-    /// that edge's first face), with that face: the key of its place in that list.
-    fn as_closed_sections_has_it(&self, curve: SectionCurve) -> (u32, SectionCurve) {
+    /// [`SectionDomain::closed_sections`] starts it (the first crossed edge of its lowest
+    /// face, into that edge's first face), with that face: the key of its place in that
+    /// list.
+    fn as_closed_sections_has_it(&mut self, curve: SectionCurve) -> (u32, SectionCurve) {
         let m = curve.faces.len();
         let j = (0..m)
             .min_by_key(|&k| curve.faces[k])
             .expect("a closed curve has faces");
         let lowest = curve.faces[j];
-        let local = self
-            .faces
-            .binary_search(&lowest)
-            .expect("a traced face is in the domain");
-        let start = self.local_face_edges[local]
+        let start = self.topology.face_edges[lowest as usize]
             .into_iter()
             .find(|&e| self.is_crossed(e))
             .expect("a traced face is crossed");
         // Face j lies between crossings j and j + 1.
-        let k = if curve.crossings[j].edge == self.edges[start as usize] {
+        let k = if curve.crossings[j].edge == start {
             j
         } else {
             (j + 1) % m
         };
-        debug_assert_eq!(curve.crossings[k].edge, self.edges[start as usize]);
-        let into = self.edge_faces[start as usize].expect("a closed curve's edges are manifold")[0];
+        debug_assert_eq!(curve.crossings[k].edge, start);
+        let into = self
+            .face_across(start, None)
+            .expect("a closed curve's edges are manifold");
         let SectionCurve {
             mut crossings,
             mut faces,
         } = curve;
-        if self.faces[into as usize] == faces[k] {
+        if into == faces[k] {
             crossings.rotate_left(k);
             faces.rotate_left(k);
         } else {
@@ -446,78 +704,116 @@ impl SectionDomain {
         let rotated = SectionCurve { crossings, faces };
         (lowest, rotated)
     }
+}
 
-    /// Whether local edge `e` has its ends on different sides.
-    fn is_crossed(&self, e: u32) -> bool {
-        let [a, b] = self.edge_ends[e as usize];
-        self.local_side[a as usize] != self.local_side[b as usize]
+impl ChainDomain for NearRayDomain<'_> {
+    fn face_edges(&self, face: u32) -> [u32; 3] {
+        self.topology.face_edges[face as usize]
     }
 
-    fn crossing(&self, e: u32) -> EdgeCrossing {
-        let [a, b] = self.edge_ends[e as usize];
-        let (da, db) = (
-            self.local_distance[a as usize],
-            self.local_distance[b as usize],
-        );
-        let point = if da == 0.0 {
-            CrossingPoint::Vertex(self.vertices[a as usize])
-        } else if db == 0.0 {
-            CrossingPoint::Vertex(self.vertices[b as usize])
-        } else {
-            CrossingPoint::Interior(da / (da - db))
-        };
+    fn is_crossed(&mut self, e: u32) -> bool {
+        let [a, b] = self.topology.edges[e as usize];
+        self.side(a) != self.side(b)
+    }
+
+    fn crossing(&mut self, e: u32) -> EdgeCrossing {
+        let [a, b] = self.topology.edges[e as usize];
+        let (da, db) = (self.distance(a), self.distance(b));
         EdgeCrossing {
-            edge: self.edges[e as usize],
-            point,
+            edge: e,
+            point: crossing_point(a, b, da, db),
         }
     }
 
-    /// The local face across local edge `e` from `from`, if `e` is manifold and both its
-    /// faces are in the domain (the first of them when there is no `from`).
     fn face_across(&self, e: u32, from: Option<u32>) -> Option<u32> {
-        let faces = self.edge_faces[e as usize]?;
-        match from {
-            Some(g) if faces[0] == g => Some(faces[1]),
-            _ => Some(faces[0]),
+        match *self.topology.faces_of_edge(e as usize) {
+            [f, g] if self.holds(f) && self.holds(g) => match from {
+                Some(h) if f == h => Some(g),
+                _ => Some(f),
+            },
+            _ => None,
         }
     }
 
-    /// Follows the chain from crossed local edge `start`; `Some` when it closes on `start`.
-    fn trace(&mut self, start: u32) -> Option<SectionCurve> {
-        self.edge_stamp[start as usize] = self.stamp;
-        // The chain grows in buffers reused by every trace; a closed one is copied out at
-        // its length (most chains of a query leave the domain and are dropped).
-        let first = self.crossing(start);
-        self.chain_crossings.clear();
-        self.chain_crossings.push(first);
-        self.chain_faces.clear();
-        let (mut edge, mut from) = (start, None);
-        loop {
-            let face = self.face_across(edge, from)?;
-            let mut others = self.local_face_edges[face as usize]
-                .iter()
-                .copied()
-                .filter(|&g| g != edge && self.is_crossed(g));
-            let next = others.next()?;
-            if others.next().is_some() {
-                return None;
-            }
-            self.chain_faces.push(self.faces[face as usize]);
-            if next == start {
-                return Some(SectionCurve {
-                    crossings: self.chain_crossings.clone(),
-                    faces: self.chain_faces.clone(),
-                });
-            }
-            if self.edge_stamp[next as usize] == self.stamp {
-                return None;
-            }
-            self.edge_stamp[next as usize] = self.stamp;
-            let crossing = self.crossing(next);
-            self.chain_crossings.push(crossing);
-            (edge, from) = (next, Some(face));
+    fn mesh_face(&self, face: u32) -> u32 {
+        face
+    }
+
+    fn visited(&self, e: u32) -> bool {
+        self.scratch.edge_query[e as usize] == self.scratch.query
+    }
+
+    fn visit(&mut self, e: u32) {
+        self.scratch.edge_query[e as usize] = self.scratch.query;
+    }
+
+    fn chain(&mut self) -> &mut Chain {
+        &mut self.chain
+    }
+}
+
+/// The faces near one joint that the plane search asks for the sections around the joint
+/// ([`JointSections::sections_around`]): a [`SectionDomain`] scanned whole below
+/// `SEGMENT_QUERY_FACES` faces, else a [`NearRayDomain`].
+#[derive(Debug)]
+pub enum JointSections<'a> {
+    Scanned(SectionDomain),
+    NearRay(NearRayDomain<'a>),
+}
+
+impl<'a> JointSections<'a> {
+    /// The domain of `faces` of `mesh` (in increasing order, those of
+    /// [`FaceSpheres::faces_near`]); faces with a repeated vertex index are left out.
+    /// `scratch` is held by a large domain until it is dropped.
+    pub fn new(
+        mesh: &'a SurfaceMesh,
+        topology: &'a Topology,
+        vertex_snap: &'a [f64],
+        faces: Vec<u32>,
+        scratch: &'a mut DomainScratch,
+    ) -> Self {
+        let faces = proper_faces(mesh, faces);
+        if faces.len() < SEGMENT_QUERY_FACES {
+            Self::Scanned(SectionDomain::new(
+                mesh,
+                topology,
+                vertex_snap,
+                faces,
+                scratch,
+            ))
+        } else {
+            Self::NearRay(NearRayDomain::new(
+                mesh,
+                topology,
+                vertex_snap,
+                &faces,
+                scratch,
+            ))
         }
     }
+
+    /// The closed sections of [`SectionDomain::closed_sections`] that can contain the
+    /// plane's point (every one that [`polygon_contains`] of `plane.normal` and
+    /// `plane.point` accepts, and perhaps others), each as that list has it (the same
+    /// crossings from the same start), in its order; `spheres` indexes the mesh. A small
+    /// domain lists all its closed sections.
+    pub fn sections_around(&mut self, plane: &Plane, spheres: &FaceSpheres) -> Vec<SectionCurve> {
+        match self {
+            Self::Scanned(domain) => domain.closed_sections(plane),
+            Self::NearRay(domain) => domain.sections_around(plane, spheres),
+        }
+    }
+}
+
+/// `faces` without those with a repeated vertex index (a curve reaching them is open).
+fn proper_faces(mesh: &SurfaceMesh, faces: Vec<u32>) -> Vec<u32> {
+    faces
+        .into_iter()
+        .filter(|&f| {
+            let [a, b, c] = mesh.triangles[f as usize];
+            a != b && b != c && a != c
+        })
+        .collect()
 }
 
 impl SectionCurve {
@@ -660,10 +956,11 @@ mod tests {
         }
     }
 
-    /// The sections around a point are those of every closed section that contain it, as
-    /// that list has them (same start, same order): a sphere, a bent tube and a U-shaped
-    /// tube (planes meeting both arms), domains of the faces near vertices and near random
-    /// points, planes through them along the axes and at random.
+    /// The sections around a point (of a [`NearRayDomain`], and of [`JointSections`]) are
+    /// those of every closed section (of a [`SectionDomain`]) that contain it, as that list
+    /// has them (same start, same order): a sphere, a bent tube and a U-shaped tube (planes
+    /// meeting both arms), domains of the faces near vertices and near random points, planes
+    /// through them along the axes and at random.
     #[test]
     fn sections_around_a_point_are_the_closed_sections_that_contain_it() {
         use crate::fixtures::shapes::{bent_cylinder, capsule_chain};
@@ -682,7 +979,13 @@ mod tests {
             let topology = Topology::new(mesh);
             let snap = vertex_snap_distances(mesh, &topology, 0.01);
             let spheres = FaceSpheres::new(mesh);
-            let mut scratch = DomainScratch::default();
+            let (mut scratch, mut joint_scratch) = Default::default();
+            // Marks and stamps about to wrap: the maps are cleared on the way.
+            let mut near_scratch = DomainScratch {
+                domain: u32::MAX - 20,
+                query: u32::MAX - 100,
+                ..DomainScratch::default()
+            };
             let mut random = numbers(17);
             let (lo, hi) = mesh.bounding_box();
             let (mut compared, mut left_out) = (0, 0);
@@ -694,7 +997,13 @@ mod tests {
                 };
                 let radius = (0.2 + random()) * (hi - lo).length() / 2.0;
                 let faces = spheres.faces_near(point, radius);
-                let mut domain = SectionDomain::new(mesh, &topology, &snap, faces, &mut scratch);
+                let proper = proper_faces(mesh, faces.clone());
+                let mut domain =
+                    SectionDomain::new(mesh, &topology, &snap, faces.clone(), &mut scratch);
+                let mut near =
+                    NearRayDomain::new(mesh, &topology, &snap, &proper, &mut near_scratch);
+                let mut joint =
+                    JointSections::new(mesh, &topology, &snap, faces, &mut joint_scratch);
                 for k in 0..8 {
                     let normal = match k {
                         0 => DVec3::Y,
@@ -712,10 +1021,10 @@ mod tests {
                             .collect()
                     };
                     let all = domain.closed_sections(&plane);
-                    let fast = domain.sections_near_ray(&plane, &spheres);
+                    let fast = near.sections_around(&plane, &spheres);
                     assert!(fast.iter().all(|c| all.contains(c)));
                     assert_eq!(around(&fast), around(&all));
-                    let chosen = domain.sections_around(&plane, &spheres);
+                    let chosen = joint.sections_around(&plane, &spheres);
                     assert_eq!(around(&chosen), around(&all));
                     compared += around(&all).len();
                     left_out += all.len() - fast.len();

@@ -71,9 +71,13 @@ impl CentreGrid {
         grid
     }
 
+    /// The cell holding `p`: ⌊(p − origin) / cell⌋ clamped to the grid. The cast truncates
+    /// toward zero instead of flooring: the two differ only below 0, where the clamp makes
+    /// both 0 (and the saturating cast treats infinities and NaN alike), so the cell is the
+    /// same without a call of the library's `floor` per coordinate (the target has no
+    /// rounding instruction).
     pub(crate) fn cell_of(&self, p: DVec3) -> IVec3 {
         ((p - self.origin) / self.cell)
-            .floor()
             .as_ivec3()
             .clamp(IVec3::ZERO, self.dims - IVec3::ONE)
     }
@@ -933,6 +937,46 @@ mod tests {
                 }
             }
             assert!(hits > joints.len(), "{file}: {hits} hits");
+        }
+    }
+
+    /// The cell by truncation is the cell by `floor`: points inside the grid, on cell
+    /// sides, just below 0 and far outside on both sides, infinite and NaN coordinates.
+    #[test]
+    fn cells_by_truncation_are_the_cells_by_floor() {
+        let grid = CentreGrid::new(&[DVec3::ZERO, DVec3::new(1.0, 2.0, 3.0)]);
+        let by_floor = |p: DVec3| {
+            ((p - grid.origin) / grid.cell)
+                .floor()
+                .as_ivec3()
+                .clamp(IVec3::ZERO, grid.dims - IVec3::ONE)
+        };
+        let values = [
+            -1e300,
+            -3.5,
+            -1.0,
+            -0.5,
+            -1e-300,
+            -0.0,
+            0.0,
+            1e-300,
+            grid.cell,
+            grid.cell * 3.0,
+            grid.cell * 3.0 - 1e-12,
+            0.7,
+            2.999,
+            1e300,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+        ];
+        for &x in &values {
+            for &y in &values {
+                for z in [0.3, -0.2, f64::NAN] {
+                    let p = DVec3::new(x, y, z);
+                    assert_eq!(grid.cell_of(p), by_floor(p), "{p}");
+                }
+            }
         }
     }
 

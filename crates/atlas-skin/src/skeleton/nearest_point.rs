@@ -1,6 +1,7 @@
-//! The nearest of a fixed set of points (the joints) to a query point, exactly: a uniform
-//! grid of a few points per cell, searched in growing shells of cells until the best
-//! distance found cannot be beaten by a farther shell. (The nearest bone:
+//! The nearest of a fixed set of points (the joints, a surface's vertices) to a query
+//! point, exactly: a uniform grid of a few points per cell, searched in growing shells of
+//! cells until the best distance found cannot be beaten by a farther shell; and the points
+//! within a radius, from the cells of the radius's box. (The nearest bone:
 //! [`super::bone_tree`].)
 
 use crate::mesh::spatial_index::CentreGrid;
@@ -53,6 +54,22 @@ impl PointGrid {
         }
         best
     }
+
+    /// The indices, increasing, of the points q with `q.distance(p)` ≤ `radius`: the same
+    /// as a scan of every point. The cells searched are those of the box around p of half
+    /// side radius (1 + 10⁻⁹): a point whose computed distance passes lies in that box
+    /// despite the rounding of its distance.
+    pub fn within(&self, p: DVec3, radius: f64) -> Vec<u32> {
+        let reach = DVec3::splat(radius * (1.0 + 1e-9));
+        let (lo, hi) = (self.grid.cell_of(p - reach), self.grid.cell_of(p + reach));
+        let mut found: Vec<u32> = self
+            .grid
+            .faces_in(lo, hi, IVec3::ONE, IVec3::ZERO)
+            .filter(|&k| self.points[k as usize].distance(p) <= radius)
+            .collect();
+        found.sort_unstable();
+        found
+    }
 }
 
 /// Visits the items of `grid` in shells of cells around `p` until none can be nearer than
@@ -94,9 +111,11 @@ mod tests {
     use atlas_skin_runtime::random_pose::SplitMix64;
 
     /// Clustered, collinear, coincident and spread points, queried inside and far outside
-    /// their box: the same distance as a scan of every point.
+    /// their box: the same nearest point and distance as a scan of every point, and the same points
+    /// within radii of 0, of a point's exact distance (on the ball's boundary), just inside
+    /// it, at random and infinite.
     #[test]
-    fn grid_gives_the_scanned_nearest_point() {
+    fn grid_answers_as_a_scan() {
         let mut rng = SplitMix64::new(3);
         let mut random =
             |scale: f64| DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64()) * scale;
@@ -118,7 +137,14 @@ mod tests {
         ];
         for points in &sets {
             let grid = PointGrid::new(points);
-            for _ in 0..300 {
+            let within = |p: DVec3, radius: f64| -> Vec<u32> {
+                (0u32..)
+                    .zip(points)
+                    .filter(|(_, q)| q.distance(p) <= radius)
+                    .map(|(k, _)| k)
+                    .collect()
+            };
+            for k in 0..300 {
                 let p = random(8.0) - DVec3::splat(2.0);
                 let scanned = points
                     .iter()
@@ -127,9 +153,28 @@ mod tests {
                 assert_eq!(grid.nearest_distance(p), scanned);
                 let nearest = grid.nearest(p);
                 assert_eq!(nearest.map(|(_, d)| d), points.first().map(|_| scanned));
-                if let Some((k, d)) = nearest {
-                    assert_eq!(points[k].distance(p), d);
+                if let Some((i, d)) = nearest {
+                    assert_eq!(points[i].distance(p), d);
                 }
+                let exact = points
+                    .get(k % points.len().max(1))
+                    .map_or(1.0, |q| q.distance(p));
+                for radius in [
+                    0.0,
+                    exact,
+                    exact * (1.0 - 1e-12),
+                    random(2.0).x,
+                    f64::INFINITY,
+                ] {
+                    assert_eq!(
+                        grid.within(p, radius),
+                        within(p, radius),
+                        "{p} within {radius}"
+                    );
+                }
+            }
+            if let Some(&q) = points.first() {
+                assert!(grid.within(q, 0.0).contains(&0));
             }
         }
     }

@@ -8,8 +8,8 @@ use crate::decomposition::{Boundary, BoundaryKind, Decomposition};
 use crate::geometry::point_segment_distance;
 use crate::overlap::Overlaps;
 use crate::rows::Rows;
-use crate::skeleton::bone_tree::BoneTree;
 use crate::skeleton::bones::bone_segments;
+use crate::skeleton::nearest_point::PointGrid;
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -100,27 +100,28 @@ pub fn soft_sides(
         .collect()
 }
 
-/// Below this many soft boundaries their seeds come from a scan of the surface's vertices:
-/// the tree of the vertices costs about as much to build as 50 scans (4.5 M instructions on
-/// the 3,273 vertices of cesiumman, which has one soft boundary).
+/// Below this many soft boundaries their seeds come from a scan of the surface's vertices.
+/// (A tree of the vertices, which the grid replaced, cost about as much to build as 50
+/// scans: 4.5 M instructions on the 3,273 vertices of cesiumman, which has one soft
+/// boundary, and 32 M on makehuman's 13,380.)
 const SCANNED_BOUNDARIES: usize = 32;
 
-/// The surface's vertices within a distance of a point, increasing, as [`BoneTree::within`]
-/// finds them in a tree of the vertices as points: by that tree, or by a scan with the
-/// same distance ([`point_segment_distance`] from the point to the vertex as a segment).
+/// The surface's vertices within a distance of a point, increasing, and the distance to
+/// the nearest, the distance from the point to a vertex q being [`point_segment_distance`]
+/// to q as a segment (which is `q.distance(p)`): by a scan, or from a grid of the vertices
+/// ([`PointGrid`], the same answers).
 enum NearVertices<'a> {
     Scan(&'a [DVec3]),
-    Tree(BoneTree),
+    Grid(PointGrid),
 }
 
 impl<'a> NearVertices<'a> {
-    /// A scan below [`SCANNED_BOUNDARIES`] queries, else the tree.
+    /// A scan below [`SCANNED_BOUNDARIES`] queries, else the grid.
     fn new(positions: &'a [DVec3], queries: usize) -> Self {
         if queries < SCANNED_BOUNDARIES {
             return Self::Scan(positions);
         }
-        let points: Vec<[DVec3; 2]> = positions.iter().map(|&p| [p, p]).collect();
-        Self::Tree(BoneTree::of_segments(&points))
+        Self::Grid(PointGrid::new(positions))
     }
 
     fn within(&self, p: DVec3, radius: f64) -> Vec<u32> {
@@ -130,19 +131,18 @@ impl<'a> NearVertices<'a> {
                 .filter(|&(_, &q)| point_segment_distance(p, q, q) <= radius)
                 .map(|(v, _)| v)
                 .collect(),
-            Self::Tree(tree) => tree.within(p, radius),
+            Self::Grid(grid) => grid.within(p, radius),
         }
     }
 
-    /// The distance from `p` to the nearest vertex (infinity when there is none), as
-    /// [`BoneTree::nearest`] finds it.
+    /// The distance from `p` to the nearest vertex (infinity when there is none).
     fn nearest(&self, p: DVec3) -> f64 {
         match self {
             Self::Scan(positions) => positions
                 .iter()
                 .map(|&q| point_segment_distance(p, q, q))
                 .fold(f64::INFINITY, f64::min),
-            Self::Tree(tree) => tree.nearest(p),
+            Self::Grid(grid) => grid.nearest_distance(p),
         }
     }
 }
@@ -249,26 +249,26 @@ mod tests {
     use super::*;
     use atlas_skin_runtime::random_pose::SplitMix64;
 
-    /// The scan of the vertices finds what the tree of the vertices finds, at radii of 0, at
+    /// The scan of the vertices finds what the grid of the vertices finds, at radii of 0, at
     /// a vertex's exact distance (on the ball's boundary), just inside it and at random.
     #[test]
-    fn the_scan_finds_the_vertices_and_the_nearest_distance_the_tree_finds() {
+    fn the_scan_finds_the_vertices_and_the_nearest_distance_the_grid_finds() {
         let mut rng = SplitMix64::new(3);
         let mut point = || DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64());
         let positions: Vec<DVec3> = (0..500).map(|_| point()).collect();
         let scan = NearVertices::new(&positions, SCANNED_BOUNDARIES - 1);
-        let tree = NearVertices::new(&positions, SCANNED_BOUNDARIES);
+        let grid = NearVertices::new(&positions, SCANNED_BOUNDARIES);
         assert!(matches!(
-            (&scan, &tree),
-            (NearVertices::Scan(_), NearVertices::Tree(_))
+            (&scan, &grid),
+            (NearVertices::Scan(_), NearVertices::Grid(_))
         ));
         for (k, &vertex) in positions.iter().enumerate().take(50) {
             let p = point();
-            assert_eq!(scan.nearest(p), tree.nearest(p), "nearest to {p}");
+            assert_eq!(scan.nearest(p), grid.nearest(p), "nearest to {p}");
             let exact = p.distance(vertex);
             for radius in [0.0, exact, exact * (1.0 - 1e-12), 0.3 * point().x] {
                 let found = scan.within(p, radius);
-                assert_eq!(found, tree.within(p, radius), "{p} within {radius}");
+                assert_eq!(found, grid.within(p, radius), "{p} within {radius}");
                 assert_eq!(found.contains(&(k as u32)), radius >= exact);
             }
         }
