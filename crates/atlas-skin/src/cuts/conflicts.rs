@@ -124,20 +124,21 @@ fn place_in_order(
             continue;
         }
         let mut blockers: Vec<u32> = Vec::new();
-        let accepted = candidates[j].iter().position(|candidate| {
-            match board.fits(mesh, topology, &candidate.curve, gap) {
-                Ok(()) => true,
-                Err(others) => {
-                    blockers.extend(others);
-                    false
+        let mut accepted = None;
+        for (k, candidate) in candidates[j].iter().enumerate() {
+            let chords: Vec<Chord> = candidate.curve.chords(mesh, topology).collect();
+            let vertices = curve_vertices(&candidate.curve);
+            match board.fits(&chords, &vertices, gap) {
+                Ok(()) => {
+                    board.place(j as u32, chords, vertices);
+                    accepted = Some(k);
+                    break;
                 }
+                Err(others) => blockers.extend(others),
             }
-        });
+        }
         placed[j] = Some(match accepted {
-            Some(k) => {
-                board.place(mesh, topology, j as u32, &candidates[j][k].curve);
-                Search::Accepted(k)
-            }
+            Some(k) => Search::Accepted(k),
             None => Search::Blocked(blockers),
         });
     }
@@ -152,19 +153,14 @@ struct Board {
 }
 
 impl Board {
-    /// `Ok` when `curve` conflicts with no placed cut, else the owners of those it meets.
-    fn fits(
-        &self,
-        mesh: &SurfaceMesh,
-        topology: &Topology,
-        curve: &SectionCurve,
-        gap: f64,
-    ) -> Result<(), Vec<u32>> {
-        let mut blockers: Vec<u32> = curve_vertices(curve)
+    /// `Ok` when a curve with these `chords` through these `vertices` conflicts with no
+    /// placed cut, else the owners of those it meets.
+    fn fits(&self, chords: &[Chord], vertices: &[u32], gap: f64) -> Result<(), Vec<u32>> {
+        let mut blockers: Vec<u32> = vertices
             .iter()
             .filter_map(|v| self.vertex_owner.get(v).copied())
             .collect();
-        for chord in curve.chords(mesh, topology) {
+        for chord in chords {
             if let Some(others) = self.chords.get(&chord.face) {
                 blockers.extend(
                     others
@@ -181,15 +177,15 @@ impl Board {
         }
     }
 
-    fn place(&mut self, mesh: &SurfaceMesh, topology: &Topology, joint: u32, curve: &SectionCurve) {
-        for chord in curve.chords(mesh, topology) {
+    fn place(&mut self, joint: u32, chords: Vec<Chord>, vertices: Vec<u32>) {
+        for chord in chords {
             self.chords
                 .entry(chord.face)
                 .or_default()
                 .push((joint, chord));
         }
         self.vertex_owner
-            .extend(curve_vertices(curve).into_iter().map(|v| (v, joint)));
+            .extend(vertices.into_iter().map(|v| (v, joint)));
     }
 }
 
