@@ -12,11 +12,12 @@ mod support;
 /// Skins `input`; returns the report's count of rows moved onto their piece's carrier and
 /// the deform figures against the artist's weights.
 fn skin_and_deform(input: &str, stem: &str) -> (u64, serde_json::Value) {
-    let input = atlas_skin_corpus::data_dir().join(input);
-    let dir = support::out_dir("attached-pieces-one-carrier");
-    let (glb, report) = support::skin_with_report(&input, &dir, stem);
-    let off_carrier = report["counts"]["off_carrier_vertices"].as_u64().unwrap();
-    (off_carrier, support::deform_random(&input, &glb))
+    support::count_and_deform(
+        input,
+        "attached-pieces-one-carrier",
+        stem,
+        "off_carrier_vertices",
+    )
 }
 
 #[test]

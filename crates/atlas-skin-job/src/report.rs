@@ -100,6 +100,7 @@ pub fn skin_report(
             "max_influences": skinned.weights.max_influences(),
             "leaf_patches": weight_counts.leaf_patches.len(),
             "far_bone_vertices": weight_counts.far_bone_vertices,
+            "sibling_blend_vertices": weight_counts.sibling_blend_vertices,
             "off_carrier_vertices": weight_counts.off_carrier,
             "duplicate_faces": counts.duplicate_faces,
             "inside_out_pieces": counts.inside_out_pieces,

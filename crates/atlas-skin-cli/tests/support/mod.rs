@@ -66,6 +66,24 @@ pub fn deform_random(reference: &Path, candidate: &Path) -> serde_json::Value {
     figures["deform_random"].clone()
 }
 
+/// Skins `input` (a path under `../shared/data`) into the output folder of `test` and returns
+/// its report's `counts.COUNT` with the deform figures against the input's own weights
+/// ([`deform_random`]).
+pub fn count_and_deform(
+    input: &str,
+    test: &str,
+    stem: &str,
+    count: &str,
+) -> (u64, serde_json::Value) {
+    let input = atlas_skin_corpus::data_dir().join(input);
+    let dir = out_dir(test);
+    let (glb, report) = skin_with_report(&input, &dir, stem);
+    let counted = report["counts"][count]
+        .as_u64()
+        .unwrap_or_else(|| panic!("the report counts no {count}"));
+    (counted, deform_random(&input, &glb))
+}
+
 /// A fresh, empty output folder for one test under the target's test temp dir.
 pub fn out_dir(test: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))

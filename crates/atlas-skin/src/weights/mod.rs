@@ -58,6 +58,11 @@
 //!    its patch ([`crate::weights::patches`]): with P = Σ_j p_j over the region's patches, every
 //!    joint of the region keeps its mass times 1 − min(1, P), and patch j receives
 //!    ω p_j / max(1, P).
+//!
+//!    **3c. Sibling blends.** Where two joints of which neither is an ancestor of the other
+//!    share a vertex (two thighs at a crotch, a neck and a clavicle), part of their common
+//!    weight goes to their lowest common ancestor when its bones are about as near
+//!    ([`siblings`]).
 //! 4. **Guard.** A weight on a joint whose bones are far from the vertex, many times
 //!    farther than the nearest bone reached through the body, is removed and the row
 //!    renormalised ([`guard`]), on the weights of steps 1–3.
@@ -84,6 +89,7 @@ pub mod ownership;
 pub mod patches;
 pub mod pieces;
 pub mod related;
+pub mod siblings;
 pub mod soft_sides;
 pub mod surface_weights;
 
@@ -96,6 +102,7 @@ use guard::guard_far_bones;
 use patches::leaf_patches;
 use pieces::weight_pieces;
 use related::{region_vertices, related_regions, vertex_bands};
+use siblings::merge_sibling_blends;
 use soft_sides::soft_sides;
 use thiserror::Error;
 
@@ -140,9 +147,18 @@ pub fn compute_weights(
         leaf_patches,
         inactive_soft_joints,
     } = region_weights(decomposition, skeleton, overlaps, blend)?;
+    let owns_skin: Vec<bool> = decomposition.joints.iter().map(|d| d.owns_skin).collect();
+    let sibling_blend_vertices = merge_sibling_blends(
+        skeleton,
+        &decomposition.surface.positions,
+        &owns_skin,
+        &leaf_patches,
+        &mut weights,
+    );
     let far_bone_vertices = guard_far_bones(decomposition, skeleton, &mut weights);
     let mut counts = weight_pieces(decomposition, skeleton, overlaps, &mut weights);
     counts.far_bone_vertices = far_bone_vertices;
+    counts.sibling_blend_vertices = sibling_blend_vertices;
     counts.leaf_patches = leaf_patches;
     counts.inactive_soft_joints = inactive_soft_joints;
     Ok((weights, counts))

@@ -62,6 +62,8 @@ pub struct WeightCounts {
     pub leaf_patches: Vec<u32>,
     /// Vertices whose weights on far joints the guard removed (step 4).
     pub far_bone_vertices: usize,
+    /// Vertices whose sibling blends gave weight to the siblings' common ancestor (step 3c).
+    pub sibling_blend_vertices: usize,
 }
 
 /// How a piece was weighted.

@@ -1,0 +1,348 @@
+//! Step 3c of the weights: blends between sibling joints pass through their common
+//! ancestor (issue 13, item 1).
+//!
+//! Two joints j and k of which neither is an ancestor of the other (two thighs, a neck and a
+//! clavicle, two palm bones) can share a vertex: where their regions' overlap bands meet (a
+//! crotch whose pelvis region is pinched to nothing between the thigh cuts), or where two
+//! soft boundaries of one region reach the same skin (the base of a neck between the
+//! shoulders). Posed, such a vertex follows the average of two transforms that turn about
+//! different pivots in unrelated directions and lands where neither limb is; artists give
+//! that skin to the joint the two limbs hang from. So part of the pair's shared weight goes
+//! to their lowest common ancestor a:
+//!
+//!   t_jk = s · f_jk · (min(w_j, w_k) − m₀)⁺ / (1 − 2 m₀),
+//!   f_jk = 1 − β(clamp((d_a / min(d_j, d_k) − ρ₀) / (ρ₁ − ρ₀), 0, 1)),
+//!
+//! with w the vertex's weights of steps 1–3, d_x the distance from the vertex to the nearest
+//! bone segment of joint x ([`bone_segments`]), β the transition function of §4
+//! ([`super::blend::beta`]), s = [`SHARE`], m₀ = [`TAIL`], ρ₀ = [`NEAR_RATIO`], ρ₁ =
+//! [`FAR_RATIO`]. On a midline (w_j = w_k = ½) each gives s/2 of its weight. A common
+//! weight below m₀ is the tail of an ordinary transition that reaches a sibling's bone, and
+//! stays. The ancestor takes the weight only where its own bones are about as near as the
+//! pair's (a pelvis joint high above a crotch that the thighs' bones pass beside is not, and
+//! the crotch stays with the thighs). Each joint j gives t_jk to the ancestor of every pair it is
+//! in, scaled by c_j = min(1, w_j / Σ_k t_jk) so that no weight goes negative:
+//!
+//!   w'_j = w_j − c_j Σ_k t_jk,   w'_a = w_a + Σ_{(j,k): a} (c_j + c_k) t_jk.
+//!
+//! Weight only moves between joints, so the row still sums to 1; every term is continuous
+//! in w and in the distances, so the weights stay continuous over the surface. Joints of
+//! leaf patches (step 3b: bones lying in the skin, such as a face's) are not paired: their
+//! skin is meant to slide between them. Measured on the benchmark in
+//! docs/measurements.md, "Sibling blends through their common ancestor".
+
+use super::blend::beta;
+use super::surface_weights::SurfaceWeights;
+use crate::geometry::point_segment_distance;
+use crate::skeleton::bones::bone_segments;
+use atlas_skin_runtime::Skeleton;
+use glam::DVec3;
+
+/// s: the share of a sibling pair's common weight min(w_j, w_k) that each of the two gives
+/// to their common ancestor (chosen on the benchmark, docs/measurements.md).
+pub const SHARE: f64 = 0.5;
+
+/// m₀: a sibling pair's common weight up to this is left alone (docs/measurements.md).
+pub const TAIL: f64 = 0.05;
+
+/// ρ₀: the ancestor takes the full share while its bones are at most this many times
+/// farther from the vertex than the nearer of the pair's.
+pub const NEAR_RATIO: f64 = 1.0;
+
+/// ρ₁: the ancestor takes nothing once its bones are this many times farther.
+pub const FAR_RATIO: f64 = 1.6;
+
+/// Moves part of every sibling blend to the pair's common ancestor (module documentation);
+/// returns how many vertices changed.
+///
+/// - `positions`: the vertices of the rows of `weights`.
+/// - `owns_skin`: per joint, whether it may take weight (an ancestor that owns no skin
+///   takes none).
+/// - `sliding`: joints whose blends are left alone (leaf patches).
+pub fn merge_sibling_blends(
+    skeleton: &Skeleton,
+    positions: &[DVec3],
+    owns_skin: &[bool],
+    sliding: &[u32],
+    weights: &mut SurfaceWeights,
+) -> usize {
+    let family = Family::new(skeleton, owns_skin, sliding);
+    let mut result = SurfaceWeights {
+        offsets: vec![0],
+        ..SurfaceWeights::default()
+    };
+    let mut changed = 0;
+    let mut row = Vec::new();
+    for (v, &p) in positions.iter().enumerate() {
+        row.clear();
+        row.extend(weights.row(v));
+        if family.merge_row(p, &mut row) {
+            changed += 1;
+        }
+        result.extend_row(row.iter().copied());
+    }
+    *weights = result;
+    changed
+}
+
+/// The skeleton's tree and bones as the rule needs them.
+struct Family {
+    parents: Vec<Option<u32>>,
+    depths: Vec<u32>,
+    /// Per joint, its bone segments.
+    segments: Vec<Vec<(DVec3, DVec3)>>,
+    owns_skin: Vec<bool>,
+    paired: Vec<bool>,
+}
+
+impl Family {
+    fn new(skeleton: &Skeleton, owns_skin: &[bool], sliding: &[u32]) -> Self {
+        let parents: Vec<Option<u32>> = (0..skeleton.len())
+            .map(|j| skeleton.parent(j).map(|p| p as u32))
+            .collect();
+        let depths = (0..skeleton.len())
+            .map(|j| skeleton.ancestors(j).count() as u32)
+            .collect();
+        let mut segments = vec![Vec::new(); skeleton.len()];
+        for (j, a, b) in bone_segments(skeleton) {
+            segments[j as usize].push((a, b));
+        }
+        let mut paired = vec![true; skeleton.len()];
+        for &j in sliding {
+            paired[j as usize] = false;
+        }
+        Self {
+            parents,
+            depths,
+            segments,
+            owns_skin: owns_skin.to_vec(),
+            paired,
+        }
+    }
+
+    /// The lowest common ancestor of j and k when neither is an ancestor of the other (and
+    /// both are in one tree).
+    fn sibling_ancestor(&self, mut j: u32, mut k: u32) -> Option<u32> {
+        let (dj, dk) = (self.depths[j as usize], self.depths[k as usize]);
+        let lift = |mut x: u32, by: u32| {
+            for _ in 0..by {
+                x = self.parents[x as usize].expect("a joint's depth counts its ancestors");
+            }
+            x
+        };
+        if dj > dk {
+            j = lift(j, dj - dk);
+        } else {
+            k = lift(k, dk - dj);
+        }
+        if j == k {
+            return None;
+        }
+        while j != k {
+            j = self.parents[j as usize]?;
+            k = self.parents[k as usize]?;
+        }
+        Some(j)
+    }
+
+    fn bone_distance(&self, p: DVec3, j: u32) -> f64 {
+        self.segments[j as usize]
+            .iter()
+            .map(|&(a, b)| point_segment_distance(p, a, b))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The rule on one row of (joint, weight) pairs at point p; whether it changed.
+    fn merge_row(&self, p: DVec3, row: &mut Vec<(u32, f64)>) -> bool {
+        // Transfers (giver, ancestor, amount) before the scaling c_j.
+        let mut transfers: Vec<(usize, u32, f64)> = Vec::new();
+        for x in 0..row.len() {
+            for y in x + 1..row.len() {
+                let ((j, wj), (k, wk)) = (row[x], row[y]);
+                if !self.paired[j as usize] || !self.paired[k as usize] {
+                    continue;
+                }
+                let Some(a) = self.sibling_ancestor(j, k) else {
+                    continue;
+                };
+                if !self.owns_skin[a as usize] {
+                    continue;
+                }
+                let near = self.bone_distance(p, j).min(self.bone_distance(p, k));
+                let ratio = self.bone_distance(p, a) / near;
+                let reach =
+                    1.0 - beta(((ratio - NEAR_RATIO) / (FAR_RATIO - NEAR_RATIO)).clamp(0.0, 1.0));
+                let common = (wj.min(wk) - TAIL).max(0.0) / (1.0 - 2.0 * TAIL);
+                let amount = SHARE * reach * common;
+                if amount > 0.0 {
+                    transfers.push((x, a, amount));
+                    transfers.push((y, a, amount));
+                }
+            }
+        }
+        if transfers.is_empty() {
+            return false;
+        }
+        let mut outflow = vec![0.0; row.len()];
+        for &(x, _, amount) in &transfers {
+            outflow[x] += amount;
+        }
+        let scale: Vec<f64> = outflow
+            .iter()
+            .zip(row.iter())
+            .map(|(&out, &(_, w))| if out > w { w / out } else { 1.0 })
+            .collect();
+        for (x, &out) in outflow.iter().enumerate() {
+            row[x].1 = if scale[x] < 1.0 { 0.0 } else { row[x].1 - out };
+        }
+        for (x, a, amount) in transfers {
+            let given = scale[x] * amount;
+            match row.iter_mut().find(|e| e.0 == a) {
+                Some(entry) => entry.1 += given,
+                None => row.push((a, given)),
+            }
+        }
+        row.retain(|&(_, w)| w > 0.0);
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use atlas_skin_runtime::NO_PARENT;
+    use glam::Vec3;
+
+    /// A pelvis at the origin with two legs hanging from hips at x = ±h (y down), a spine up
+    /// from the pelvis, and a knee under each hip: a crotch between the hips at height y.
+    fn legs(h: f32) -> Skeleton {
+        Skeleton::from_positions(
+            ["pelvis", "spine", "hip.L", "knee.L", "hip.R", "knee.R"]
+                .map(String::from)
+                .to_vec(),
+            vec![NO_PARENT, 0, 0, 2, 0, 4],
+            &[
+                Vec3::ZERO,
+                Vec3::Y,
+                Vec3::new(h, 0.0, 0.0),
+                Vec3::new(h, -1.0, 0.0),
+                Vec3::new(-h, 0.0, 0.0),
+                Vec3::new(-h, -1.0, 0.0),
+            ],
+        )
+        .unwrap()
+    }
+
+    fn merged(
+        skeleton: &Skeleton,
+        p: DVec3,
+        row: &[(u32, f64)],
+        sliding: &[u32],
+    ) -> Vec<(u32, f64)> {
+        let mut weights = SurfaceWeights {
+            offsets: vec![0],
+            ..SurfaceWeights::default()
+        };
+        weights.extend_row(row.iter().copied());
+        merge_sibling_blends(
+            skeleton,
+            &[p],
+            &vec![true; skeleton.len()],
+            sliding,
+            &mut weights,
+        );
+        let mut row: Vec<(u32, f64)> = weights.row(0).collect();
+        row.sort_by_key(|e| e.0);
+        row
+    }
+
+    fn weight(row: &[(u32, f64)], joint: u32) -> f64 {
+        row.iter().find(|e| e.0 == joint).map_or(0.0, |e| e.1)
+    }
+
+    #[test]
+    fn a_midline_between_two_thighs_goes_half_to_the_pelvis() {
+        // Bones of the hips run from (±0.1, 0, 0) down: a crotch point at (0, -0.05, 0.05)
+        // is 0.112 from each and 0.071 from the pelvis's bones (to the hips, to the spine).
+        let skeleton = legs(0.1);
+        let p = DVec3::new(0.0, -0.05, 0.05);
+        let row = merged(&skeleton, p, &[(2, 0.5), (4, 0.5)], &[]);
+        // Each thigh gives s · (½ − m₀) / (1 − 2 m₀) = s / 2 of its ½.
+        let given = SHARE * 0.5;
+        assert!((weight(&row, 0) - 2.0 * given).abs() < 1e-12, "{row:?}");
+        assert!((weight(&row, 2) - (0.5 - given)).abs() < 1e-12, "{row:?}");
+        assert!((weight(&row, 4) - (0.5 - given)).abs() < 1e-12, "{row:?}");
+        assert!((row.iter().map(|e| e.1).sum::<f64>() - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_pelvis_far_above_the_crotch_takes_nothing() {
+        // Hips 1 apart, their bones running down from (±0.5, 0, 0): a crotch point 0.6 under
+        // the pelvis is 0.6 from the pelvis's bones and 0.5 from the thighs' (ratio 1.2,
+        // inside the fade) ...
+        let skeleton = legs(0.5);
+        let near = DVec3::new(0.0, -0.6, 0.0);
+        let row = merged(&skeleton, near, &[(2, 0.5), (4, 0.5)], &[]);
+        assert!(weight(&row, 0) > 0.0 && weight(&row, 0) < SHARE, "{row:?}");
+        // ... and at y = −1 it is 1 from them against the thighs' 0.5 (ratio 2 > ρ₁).
+        let far = DVec3::new(0.0, -1.0, 0.0);
+        let row = merged(&skeleton, far, &[(2, 0.5), (4, 0.5)], &[]);
+        assert_eq!(row, vec![(2, 0.5), (4, 0.5)]);
+    }
+
+    #[test]
+    fn parents_and_children_tails_and_sliding_joints_are_left_alone() {
+        let skeleton = legs(0.1);
+        let p = DVec3::new(0.05, -0.05, 0.05);
+        // A thigh and its own knee: not siblings.
+        let row = [(2, 0.5), (3, 0.5)];
+        assert_eq!(merged(&skeleton, p, &row, &[]), row.to_vec());
+        // A common weight of m₀ or less is a transition's tail.
+        let row = [(2, 1.0 - TAIL), (4, TAIL)];
+        assert_eq!(merged(&skeleton, p, &row, &[]), row.to_vec());
+        // Leaf patches slide.
+        let row = [(2, 0.5), (4, 0.5)];
+        assert_eq!(merged(&skeleton, p, &row, &[4]), row.to_vec());
+    }
+
+    #[test]
+    fn many_siblings_keep_a_partition_of_unity_and_change_continuously() {
+        // Five fingers from one hand at the origin, their bones along +y, fanned in x.
+        let mut positions = vec![Vec3::ZERO];
+        let mut parents = vec![NO_PARENT];
+        for f in 0..5 {
+            let x = 0.1 * (f as f32 - 2.0);
+            positions.push(Vec3::new(x, 0.5, 0.0));
+            parents.push(0);
+            positions.push(Vec3::new(x, 1.0, 0.0));
+            parents.push(1 + 2 * f);
+        }
+        let names = (0..positions.len()).map(|j| format!("j{j}")).collect();
+        let skeleton = Skeleton::from_positions(names, parents, &positions).unwrap();
+        let p = DVec3::new(0.0, 0.45, 0.02);
+        let fingers = [1u32, 3, 5, 7, 9];
+        // The middle finger's share t grows from 0 to 1, the others share the rest.
+        let row = |t: f64| -> Vec<(u32, f64)> {
+            fingers
+                .iter()
+                .map(|&j| (j, if j == 5 { t } else { (1.0 - t) / 4.0 }))
+                .filter(|e| e.1 > 0.0)
+                .collect()
+        };
+        let h = 1e-7;
+        for step in 0..100 {
+            let t = step as f64 / 100.0;
+            let out = merged(&skeleton, p, &row(t), &[]);
+            assert!(out.iter().all(|e| e.1 >= 0.0), "{out:?}");
+            assert!(
+                (out.iter().map(|e| e.1).sum::<f64>() - 1.0).abs() < 1e-12,
+                "{out:?}"
+            );
+            let next = merged(&skeleton, p, &row(t + h), &[]);
+            let change: f64 = (0..skeleton.len() as u32)
+                .map(|j| (weight(&next, j) - weight(&out, j)).abs())
+                .sum();
+            assert!(change < 100.0 * h, "t = {t}: {out:?} → {next:?}");
+        }
+    }
+}
