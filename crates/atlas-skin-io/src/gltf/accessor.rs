@@ -440,7 +440,14 @@ pub(crate) fn read_uints(
             }
         )));
     }
-    Ok(accessor.decode(0, |b| component.decode_u32(b).unwrap_or(0)))
+    // Each component type with its decoding inlined into the loop (one match per
+    // accessor, not one per component; the generic decoding is the reference the tests
+    // compare with).
+    Ok(match component {
+        ComponentType::U8 => accessor.decode(0, |b| ComponentType::U8.decode_u32(b).unwrap_or(0)),
+        ComponentType::U16 => accessor.decode(0, |b| ComponentType::U16.decode_u32(b).unwrap_or(0)),
+        _ => accessor.decode(0, |b| ComponentType::U32.decode_u32(b).unwrap_or(0)),
+    })
 }
 
 #[cfg(test)]
@@ -496,5 +503,31 @@ mod tests {
                 "normalized is not an index"
             );
         });
+    }
+
+    /// Unsigned integers of every width, tightly packed and strided, read as the generic
+    /// per-component decoding reads them.
+    #[test]
+    fn unsigned_integers_of_every_width_match_the_generic_decoding() {
+        let bytes: Vec<u8> = (0..96u32).map(|i| (i * 37 + 11) as u8).collect();
+        for component in [ComponentType::U8, ComponentType::U16, ComponentType::U32] {
+            let size = component.size();
+            for stride in [2 * size, 2 * size + 4] {
+                let count = bytes.len() / stride;
+                let json = json!({
+                    "bufferViews": [{"buffer": 0, "byteLength": bytes.len(), "byteStride": stride}],
+                    "accessors": [{"bufferView": 0, "componentType": component.code(),
+                                   "count": count, "type": "VEC2"}]
+                });
+                let expected: Vec<u32> = (0..count)
+                    .flat_map(|i| (0..2).map(move |c| i * stride + c * size))
+                    .map(|at| component.decode_u32(&bytes[at..]).unwrap())
+                    .collect();
+                doc_with(&json, std::slice::from_ref(&bytes), |doc| {
+                    let read = read_uints(doc, 0, "VEC2", "test").unwrap();
+                    assert_eq!(read, expected, "{component:?}, stride {stride}");
+                });
+            }
+        }
     }
 }
