@@ -33,7 +33,7 @@
 
 use super::blend::beta;
 use super::surface_weights::SurfaceWeights;
-use crate::geometry::point_segment_distance;
+use crate::skeleton::bone_tree::{BoneTree, Keys, Split};
 use crate::skeleton::bones::bone_segments;
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
@@ -89,8 +89,8 @@ pub fn merge_sibling_blends(
 struct Family {
     parents: Vec<Option<u32>>,
     depths: Vec<u32>,
-    /// Per joint, its bone segments.
-    segments: Vec<Vec<(DVec3, DVec3)>>,
+    /// The bone segments keyed by joint (a root may have thousands of child bones).
+    bones: BoneTree,
     owns_skin: Vec<bool>,
     paired: Vec<bool>,
 }
@@ -103,10 +103,6 @@ impl Family {
         let depths = (0..skeleton.len())
             .map(|j| skeleton.ancestors(j).count() as u32)
             .collect();
-        let mut segments = vec![Vec::new(); skeleton.len()];
-        for (j, a, b) in bone_segments(skeleton) {
-            segments[j as usize].push((a, b));
-        }
         let mut paired = vec![true; skeleton.len()];
         for &j in sliding {
             paired[j as usize] = false;
@@ -114,7 +110,7 @@ impl Family {
         Self {
             parents,
             depths,
-            segments,
+            bones: BoneTree::new(bone_segments(skeleton), Split::Keys),
             owns_skin: owns_skin.to_vec(),
             paired,
         }
@@ -145,11 +141,10 @@ impl Family {
         Some(j)
     }
 
+    /// d_j: the distance from `p` to the nearest bone segment of joint j.
     fn bone_distance(&self, p: DVec3, j: u32) -> f64 {
-        self.segments[j as usize]
-            .iter()
-            .map(|&(a, b)| point_segment_distance(p, a, b))
-            .fold(f64::INFINITY, f64::min)
+        self.bones
+            .nearest_distance(p, Keys::Inside(j, j + 1), |_, _| true)
     }
 
     /// The rule on one row of (joint, weight) pairs at point p; whether it changed.
