@@ -14,7 +14,7 @@
 use crate::cuts::conflicts::{place_cuts, Placement};
 use crate::cuts::joint_roles::{plan_joints, JointFrame, JointPlan};
 use crate::cuts::plane_search::{find_cut_candidates, CutCandidate, CutSearch, CutSurface};
-use crate::cuts::plane_section::{diameter, vertex_snap_distances, DomainScratch};
+use crate::cuts::plane_section::{diameter, vertex_snap_distances, ScratchPool};
 use crate::cuts::split::split_along_curves;
 use crate::decomposition::{Boundary, BoundaryKind, Decomposition, JointDecision, JointStatus};
 use crate::mesh::{FaceSpheres, SurfaceMesh, Topology};
@@ -355,20 +355,25 @@ enum Outcome {
     Skip(String),
 }
 
-/// The cut search of every joint that gets a boundary (in parallel over joints); the
-/// other bones a section must not enclose are all bones not at the joint.
+/// The cut search of every joint that gets a boundary (in parallel over joints, the
+/// scratch maps lent from job to job by a [`ScratchPool`]); the other bones a section must
+/// not enclose are all bones not at the joint.
 fn search_all_cuts(surface: &CutSurface, bones: &BoneIndex, plans: &[JointPlan]) -> Vec<CutSearch> {
+    let pool = ScratchPool::default();
     plans
         .par_iter()
         .enumerate()
-        .map_init(DomainScratch::default, |scratch, (j, plan)| match plan {
-            JointPlan::Boundary(frame)
-            | JointPlan::Soft(frame, _)
-            | JointPlan::CutOrSkip(frame, _) => {
-                find_cut_candidates(surface, j, frame, bones, scratch)
-            }
-            JointPlan::Skip(_) | JointPlan::Exclude(_) => CutSearch::default(),
-        })
+        .map_init(
+            || pool.lend(),
+            |scratch, (j, plan)| match plan {
+                JointPlan::Boundary(frame)
+                | JointPlan::Soft(frame, _)
+                | JointPlan::CutOrSkip(frame, _) => {
+                    find_cut_candidates(surface, j, frame, bones, scratch)
+                }
+                JointPlan::Skip(_) | JointPlan::Exclude(_) => CutSearch::default(),
+            },
+        )
         .collect()
 }
 
