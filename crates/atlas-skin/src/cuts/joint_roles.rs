@@ -32,7 +32,7 @@
 //!    others ([`JointFrame::on_mirror_plane`]), and it is soft when no clean cut fits.
 //!    Off the plane (a clavicle with a breast bone, a wrist with five finger bones) a
 //!    branching joint is cut like a chain joint whose lower bone is the mean of its unit
-//!    child directions — for a wrist, the average finger direction.
+//!    child directions — for a wrist, the average finger direction (but see rule 7).
 //! 5. A leaf owns geometry when the surface runs on past it. Either test suffices:
 //!    (a) the ray from p_J along the upper bone u leaves the surface from inside (hit face
 //!    normal along the ray on an outward-oriented surface) at a distance ≥
@@ -50,6 +50,14 @@
 //! 6. Twist and helper joints on a straight bone are chain joints with collinear bones: they
 //!    are cut perpendicular to the bone (the cone search), and the weights stage blends the
 //!    regions of one limb; nothing tells them apart from a straight elbow geometrically.
+//! 7. The lower bone l of a joint with several children is the mean m̂ of their unit
+//!    directions, unless they spread (|m̄| < cos 45°, m̄ the mean before normalising: two
+//!    children more than 90° apart) and m̂ turns back along the upper bone u (u · m̂ < −½).
+//!    The mean of children that part to both sides is no bone: what is left of it is a
+//!    small remainder pointing anywhere (a pelvis hanging below a waist whose thighs go out
+//!    sideways and a little up), and the bisector of u and that remainder tilts the joint's
+//!    plane through the trunk. Then l = u: the joint is cut across its upper bone. A single
+//!    child folding back (a sharp bend) keeps its mitre.
 //!
 //! The mirror plane is inferred from joint positions alone (names are not used): the plane
 //! x · n = c, among the coordinate planes and the bisector planes of sibling pairs of equal
@@ -145,6 +153,17 @@ const OFF_AXIS_COSINE: f64 = 0.25;
 /// nearer lies in the skin (a face bone): the part nearest to it is a patch of skin, not a
 /// part of the body past it.
 const INTERIOR_RADIUS: f64 = 0.1;
+
+/// Rule 7: children spread when the mean of their unit directions is shorter than this
+/// (cos 45°: two children more than 90° apart). On the benchmark 0.6 gives the same weights,
+/// 0.75 moves one character by 0.3%; 0.5 misses a pelvis whose thighs are 113° apart
+/// (docs/measurements.md).
+const SPREAD_MEAN_LENGTH: f64 = std::f64::consts::FRAC_1_SQRT_2;
+
+/// Rule 7: spread children fold back when their mean direction makes more than 120° with
+/// the upper bone (cos 60° = ½; ¼ gives the same weights on the benchmark, 0 catches
+/// joints whose children spread sideways and less than 95° from the upper bone).
+const FOLD_BACK_COSINE: f64 = 0.5;
 
 /// Decides, for every joint of `skeleton` (bind positions `positions`, bones `bones`),
 /// whether it gets a boundary; `overrides` has one entry per joint.
@@ -260,7 +279,7 @@ impl Rig<'_> {
         JointPlan::Boundary(frame)
     }
 
-    /// The frame of joint `j` (rules 1–3): upper and lower directions, bone lengths, the
+    /// The frame of joint `j` (rules 1–3 and 7): upper and lower directions, bone lengths, the
     /// surface distance and whether it branches on the mirror plane; `None` when all its
     /// bones have zero length.
     fn bones_at(&self, j: usize) -> Option<Bones> {
@@ -275,13 +294,16 @@ impl Rig<'_> {
             .map(|&c| positions[c] - p)
             .filter(|v| v.length() > NEGLIGIBLE * scale)
             .collect();
-        let lower_mean: DVec3 = child_vectors.iter().map(|v| v.normalize()).sum();
         let upper = if upper_vector.length() > NEGLIGIBLE * scale {
             upper_vector.normalize()
         } else {
-            lower_mean.normalize_or_zero()
+            child_vectors
+                .iter()
+                .map(|v| v.normalize())
+                .sum::<DVec3>()
+                .normalize_or_zero()
         };
-        let lower = lower_mean.try_normalize().unwrap_or(upper);
+        let lower = lower_direction(upper, &child_vectors);
         if upper == DVec3::ZERO {
             return None;
         }
@@ -310,6 +332,22 @@ impl Rig<'_> {
             child_vectors,
             longest_bone,
         })
+    }
+}
+
+/// The lower bone's unit direction of a joint with upper bone `upper` and bones
+/// `child_vectors` to its children (rule 7): the mean m̂ of the children's unit directions,
+/// or `upper` when there are none or when they spread and fold back.
+fn lower_direction(upper: DVec3, child_vectors: &[DVec3]) -> DVec3 {
+    let sum: DVec3 = child_vectors.iter().map(|v| v.normalize()).sum();
+    let Some(mean) = sum.try_normalize() else {
+        return upper;
+    };
+    let spread = sum.length() < SPREAD_MEAN_LENGTH * child_vectors.len() as f64;
+    if child_vectors.len() >= 2 && spread && upper.dot(mean) < -FOLD_BACK_COSINE {
+        upper
+    } else {
+        mean
     }
 }
 
@@ -702,5 +740,45 @@ mod tests {
         assert_eq!(leaf_part_at_bend(90.0), LeafPart::OffAxis);
         // A straight tube ends at its cap: the ray along the bone leaves it a radius away.
         assert_eq!(leaf_part_at_bend(0.0), LeafPart::Owned);
+    }
+
+    #[test]
+    fn children_that_spread_and_fold_back_leave_the_upper_bone_as_the_lower() {
+        let down = DVec3::NEG_Y;
+        let unit = |x: f64, y: f64, z: f64| DVec3::new(x, y, z).normalize();
+        // A pelvis hanging below a waist, its thighs out to both sides, a little up and
+        // back: their mean is a short remainder pointing up and back.
+        let waist_to_pelvis = unit(0.0, -0.07, 0.04);
+        let thighs = [
+            DVec3::new(0.043, 0.011, -0.026),
+            DVec3::new(-0.044, 0.011, -0.026),
+        ];
+        assert_eq!(lower_direction(waist_to_pelvis, &thighs), waist_to_pelvis);
+        // Reached straight from above, the remainder turns less than 120° from the upper
+        // bone: kept.
+        assert!(lower_direction(down, &thighs).y > 0.0);
+        // The same thighs below a pelvis reached from above at a slant keep their mean
+        // where it does not turn back.
+        let level = [DVec3::new(0.04, -0.01, 0.0), DVec3::new(-0.04, -0.01, 0.0)];
+        assert_eq!(lower_direction(down, &level), DVec3::NEG_Y);
+        // A chest: neck up, arms to both sides; the mean points on along the spine.
+        let up = DVec3::Y;
+        let chest = [DVec3::Y, DVec3::X, DVec3::NEG_X];
+        assert!(lower_direction(up, &chest).abs_diff_eq(up, 1e-12));
+        // A wrist: fingers spread a little; the mean finger direction.
+        let fingers = [
+            unit(1.0, 0.2, 0.0),
+            unit(1.0, 0.0, 0.0),
+            unit(1.0, -0.2, 0.0),
+        ];
+        assert!(lower_direction(DVec3::X, &fingers).abs_diff_eq(DVec3::X, 1e-12));
+        // One child folding back at a sharp bend keeps its own direction (the mitre).
+        let folded = [DVec3::new(0.2, 1.0, 0.0)];
+        assert!(lower_direction(down, &folded).abs_diff_eq(folded[0].normalize(), 1e-12));
+        // Two children folding back together (not spread) keep their mean.
+        let tails = [unit(0.1, 1.0, 0.0), unit(-0.1, 1.0, 0.0)];
+        assert!(lower_direction(down, &tails).abs_diff_eq(up, 1e-12));
+        // No children: the upper bone.
+        assert_eq!(lower_direction(down, &[]), down);
     }
 }
