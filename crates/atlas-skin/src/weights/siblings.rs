@@ -100,16 +100,13 @@ impl Family {
         let parents: Vec<Option<u32>> = (0..skeleton.len())
             .map(|j| skeleton.parent(j).map(|p| p as u32))
             .collect();
-        let depths = (0..skeleton.len())
-            .map(|j| skeleton.ancestors(j).count() as u32)
-            .collect();
         let mut paired = vec![true; skeleton.len()];
         for &j in sliding {
             paired[j as usize] = false;
         }
         Self {
+            depths: depths(skeleton),
             parents,
-            depths,
             bones: BoneTree::new(bone_segments(skeleton), Split::Keys),
             owns_skin: owns_skin.to_vec(),
             paired,
@@ -202,6 +199,18 @@ impl Family {
     }
 }
 
+/// Each joint's depth (its number of ancestors), parents first in one pass: walking up
+/// from every joint would cost the square of a chain's length.
+fn depths(skeleton: &Skeleton) -> Vec<u32> {
+    let mut depths = vec![0; skeleton.len()];
+    for j in skeleton.topological_order() {
+        if let Some(p) = skeleton.parent(j) {
+            depths[j] = depths[p] + 1;
+        }
+    }
+    depths
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -253,6 +262,20 @@ mod tests {
 
     fn weight(row: &[(u32, f64)], joint: u32) -> f64 {
         row.iter().find(|e| e.0 == joint).map_or(0.0, |e| e.1)
+    }
+
+    #[test]
+    fn depths_count_the_ancestors_with_parents_after_children_and_several_roots() {
+        // Roots 1 and 4; the chain 1 → 3 → 0 → 2 → 6 runs against the index order.
+        let parents = vec![3, NO_PARENT, 0, 1, NO_PARENT, 4, 2];
+        let names = (0..parents.len()).map(|j| format!("j{j}")).collect();
+        let skeleton =
+            Skeleton::from_positions(names, parents, &[Vec3::ZERO; 7]).expect("a forest");
+        let ancestors: Vec<u32> = (0..skeleton.len())
+            .map(|j| skeleton.ancestors(j).count() as u32)
+            .collect();
+        assert_eq!(depths(&skeleton), ancestors);
+        assert_eq!(ancestors, vec![2, 0, 3, 1, 0, 1, 4]);
     }
 
     #[test]
