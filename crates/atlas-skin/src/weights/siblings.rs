@@ -14,7 +14,7 @@
 //!   f_jk = 1 − β(clamp((d_a / min(d_j, d_k) − ρ₀) / (ρ₁ − ρ₀), 0, 1)),
 //!
 //! with w the vertex's weights of steps 1–3, d_x the distance from the vertex to the nearest
-//! bone segment of joint x ([`bone_segments`]), β the transition function of §4
+//! bone segment of joint x ([`JointBones::distance`]), β the transition function of §4
 //! ([`super::blend::beta`]), s = [`SHARE`], m₀ = [`TAIL`], ρ₀ = [`NEAR_RATIO`], ρ₁ =
 //! [`FAR_RATIO`]. On a midline (w_j = w_k = ½) each gives s/2 of its weight. A common
 //! weight below m₀ is the tail of an ordinary transition that reaches a sibling's bone, and
@@ -33,8 +33,7 @@
 
 use super::blend::beta;
 use super::surface_weights::SurfaceWeights;
-use crate::skeleton::bone_tree::{BoneTree, Keys, Split};
-use crate::skeleton::bones::bone_segments;
+use crate::skeleton::bones::JointBones;
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
 
@@ -56,17 +55,19 @@ pub const FAR_RATIO: f64 = 1.6;
 /// returns how many vertices changed.
 ///
 /// - `positions`: the vertices of the rows of `weights`.
+/// - `joint_bones`: the bone segments of `skeleton` keyed by joint, for the d_x.
 /// - `owns_skin`: per joint, whether it may take weight (an ancestor that owns no skin
 ///   takes none).
 /// - `sliding`: joints whose blends are left alone (leaf patches).
 pub fn merge_sibling_blends(
     skeleton: &Skeleton,
     positions: &[DVec3],
+    joint_bones: &JointBones,
     owns_skin: &[bool],
     sliding: &[u32],
     weights: &mut SurfaceWeights,
 ) -> usize {
-    let family = Family::new(skeleton, owns_skin, sliding);
+    let family = Family::new(skeleton, joint_bones, owns_skin, sliding);
     let mut result = SurfaceWeights {
         offsets: vec![0],
         ..SurfaceWeights::default()
@@ -86,17 +87,21 @@ pub fn merge_sibling_blends(
 }
 
 /// The skeleton's tree and bones as the rule needs them.
-struct Family {
+struct Family<'a> {
     parents: Vec<Option<u32>>,
     depths: Vec<u32>,
-    /// The bone segments keyed by joint (a root may have thousands of child bones).
-    bones: BoneTree,
+    bones: &'a JointBones,
     owns_skin: Vec<bool>,
     paired: Vec<bool>,
 }
 
-impl Family {
-    fn new(skeleton: &Skeleton, owns_skin: &[bool], sliding: &[u32]) -> Self {
+impl<'a> Family<'a> {
+    fn new(
+        skeleton: &Skeleton,
+        bones: &'a JointBones,
+        owns_skin: &[bool],
+        sliding: &[u32],
+    ) -> Self {
         let parents: Vec<Option<u32>> = (0..skeleton.len())
             .map(|j| skeleton.parent(j).map(|p| p as u32))
             .collect();
@@ -107,7 +112,7 @@ impl Family {
         Self {
             depths: depths(skeleton),
             parents,
-            bones: BoneTree::new(bone_segments(skeleton), Split::Keys),
+            bones,
             owns_skin: owns_skin.to_vec(),
             paired,
         }
@@ -140,8 +145,7 @@ impl Family {
 
     /// d_j: the distance from `p` to the nearest bone segment of joint j.
     fn bone_distance(&self, p: DVec3, j: u32) -> f64 {
-        self.bones
-            .nearest_distance(p, Keys::Inside(j, j + 1), |_, _| true)
+        self.bones.distance(p, j)
     }
 
     /// The rule on one row of (joint, weight) pairs at point p; whether it changed.
@@ -214,6 +218,7 @@ fn depths(skeleton: &Skeleton) -> Vec<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::skeleton::bones::bone_segments;
     use atlas_skin_runtime::NO_PARENT;
     use glam::Vec3;
 
@@ -251,6 +256,7 @@ mod tests {
         merge_sibling_blends(
             skeleton,
             &[p],
+            &JointBones::new(&bone_segments(skeleton)),
             &vec![true; skeleton.len()],
             sliding,
             &mut weights,
