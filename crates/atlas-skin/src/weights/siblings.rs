@@ -68,21 +68,25 @@ pub fn merge_sibling_blends(
     weights: &mut SurfaceWeights,
 ) -> usize {
     let family = Family::new(skeleton, joint_bones, owns_skin, sliding);
-    let mut result = SurfaceWeights {
-        offsets: vec![0],
-        ..SurfaceWeights::default()
-    };
-    let mut changed = 0;
     let mut row = Vec::new();
-    for (v, &p) in positions.iter().enumerate() {
+    let merge = |source: &SurfaceWeights, v: usize, row: &mut Vec<(u32, f64)>| {
         row.clear();
-        row.extend(weights.row(v));
-        if family.merge_row(p, &mut row) {
+        row.extend(source.row(v));
+        family.merge_row(positions[v], row)
+    };
+    let Some(first) = (0..positions.len()).find(|&v| merge(weights, v, &mut row)) else {
+        return 0;
+    };
+    // The rows before the first that changes stay as they are.
+    let source = std::mem::take(weights);
+    *weights = source.first_rows(first);
+    let mut changed = 0;
+    for v in first..positions.len() {
+        if merge(&source, v, &mut row) {
             changed += 1;
         }
-        result.extend_row(row.iter().copied());
+        weights.extend_row(row.iter().copied());
     }
-    *weights = result;
     changed
 }
 
@@ -282,6 +286,51 @@ mod tests {
             .collect();
         assert_eq!(depths(&skeleton), ancestors);
         assert_eq!(ancestors, vec![2, 0, 3, 1, 0, 1, 4]);
+    }
+
+    #[test]
+    fn rows_before_and_after_the_first_change_are_kept_in_place() {
+        // The crotch of the first test between vertices whose rows do not change.
+        let skeleton = legs(0.1);
+        let crotch = DVec3::new(0.0, -0.05, 0.05);
+        let (thigh, elsewhere) = (DVec3::new(0.1, -0.5, 0.05), DVec3::new(0.0, 1.0, 0.0));
+        let rows: [&[(u32, f64)]; 4] = [
+            &[(2, 1.0)],
+            &[(2, 0.5), (4, 0.5)],
+            &[(1, 0.7), (0, 0.3)],
+            &[(2, 0.5), (3, 0.5)],
+        ];
+        let positions = [thigh, crotch, elsewhere, thigh];
+        let mut weights = SurfaceWeights {
+            offsets: vec![0],
+            ..SurfaceWeights::default()
+        };
+        for row in rows {
+            weights.extend_row(row.iter().copied());
+        }
+        let joint_bones = JointBones::new(&bone_segments(&skeleton));
+        let owns_skin = vec![true; skeleton.len()];
+        let merge = |weights: &mut SurfaceWeights, positions: &[DVec3]| {
+            merge_sibling_blends(&skeleton, positions, &joint_bones, &owns_skin, &[], weights)
+        };
+        let before = weights.clone();
+        // Without the crotch nothing changes.
+        let mut unchanged = before.first_rows(1);
+        assert_eq!(merge(&mut unchanged, &positions[..1]), 0);
+        assert_eq!(unchanged, before.first_rows(1));
+        assert_eq!(merge(&mut weights, &positions), 1);
+        assert_eq!(weights.vertex_count(), 4);
+        for v in [0, 2, 3] {
+            assert_eq!(
+                weights.row(v).collect::<Vec<_>>(),
+                before.row(v).collect::<Vec<_>>()
+            );
+        }
+        let crotch_row = merged(&skeleton, crotch, rows[1], &[]);
+        let mut row: Vec<(u32, f64)> = weights.row(1).collect();
+        row.sort_by_key(|e| e.0);
+        assert_eq!(row, crotch_row);
+        assert!(weight(&row, 0) > 0.0);
     }
 
     #[test]
