@@ -1,9 +1,10 @@
 //! Bones as segments: the segments each joint moves, point-to-segment distances, the
-//! nearest bone of a point, and the rigid binding of every vertex to its nearest bone (the
-//! simplest automatic weights: the fallback of the weights stage and a baseline).
+//! nearest bone of a point, the distance to each joint's bones, and the rigid binding of
+//! every vertex to its nearest bone (the simplest automatic weights: the fallback of the
+//! weights stage and a baseline).
 
 use crate::geometry::point_segment_distance;
-use crate::skeleton::bone_tree::{BoneTree, Split};
+use crate::skeleton::bone_tree::{BoneTree, Keys, Split};
 use crate::tolerance::NEGLIGIBLE;
 use atlas_skin_runtime::{Skeleton, VertexWeights};
 use glam::DVec3;
@@ -118,6 +119,31 @@ impl<'a> JointsOnSegments<'a> {
             ControlFlow::Break(stop) => Some(stop),
             ControlFlow::Continue(()) => None,
         }
+    }
+}
+
+/// The bone segments of every joint in a tree keyed by joint ([`Split::Keys`]), for d_j:
+/// the distance from a point to the nearest bone segment of joint j, in one descent rather
+/// than a scan of the joint's bones (a root may have thousands of child bones).
+#[derive(Debug, Clone)]
+pub struct JointBones {
+    tree: BoneTree,
+}
+
+impl JointBones {
+    /// - `segments`: (joint, start, end) triples, as [`bone_segments`] gives them.
+    pub fn new(segments: &[(u32, DVec3, DVec3)]) -> Self {
+        Self {
+            tree: BoneTree::new(segments.iter().copied(), Split::Keys),
+        }
+    }
+
+    /// d_j: the distance from `p` to the nearest bone segment of `joint` (infinity when it
+    /// has none), the minimum of a scan of its segments to rounding
+    /// ([`BoneTree::nearest_distance`]).
+    pub fn distance(&self, p: DVec3, joint: u32) -> f64 {
+        self.tree
+            .nearest_distance(p, Keys::Inside(joint, joint + 1), |_, _| true)
     }
 }
 

@@ -23,8 +23,8 @@ use crate::decomposition::Decomposition;
 use crate::geometry::{point_segment_distance, segment_parameter};
 use crate::mesh::FaceSpheres;
 use crate::rows::{Rows, PAR_CHUNK};
-use crate::skeleton::bone_tree::{BoneTree, Keys, Split};
-use crate::skeleton::bones::bone_segments;
+use crate::skeleton::bone_tree::BoneTree;
+use crate::skeleton::bones::{bone_segments, JointBones};
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
 
@@ -42,9 +42,12 @@ const SIGHT_TRIES: usize = 8;
 /// Removes the weights of far joints at every vertex of `weights` (module documentation);
 /// returns how many vertices changed. Joints that own no skin take part only where they
 /// already have weight.
+///
+/// - `joint_bones`: the [`bone_segments`] of `skeleton` keyed by joint, for the d_j.
 pub fn guard_far_bones(
     decomposition: &Decomposition,
     skeleton: &Skeleton,
+    joint_bones: &JointBones,
     weights: &mut SurfaceWeights,
 ) -> usize {
     let surface = &decomposition.surface;
@@ -56,7 +59,7 @@ pub fn guard_far_bones(
         return 0;
     }
     let floor = NEAR_FLOOR * surface.diagonal();
-    let far = FarJoints::new(&segments, skeleton.len(), floor);
+    let far = FarJoints::new(&segments, joint_bones, skeleton.len(), floor);
     // Vertices with a joint that is far even from the nearest bone by straight line: only
     // they need the line-of-sight test.
     let suspects: Vec<usize> = (0..weights.vertex_count())
@@ -119,12 +122,15 @@ const BOUND_SEGMENTS: usize = 4;
 /// The straight-line test of the guard: whether a weighted joint j of a vertex p is far
 /// even from the nearest bone of all, d_j > R · max(d_min, ε · D) with d_min the distance
 /// to the nearest bone segment (a vertex passing it is then tested for a line of sight).
-struct FarJoints {
+/// Only the segments it is given count: a joint with none is at infinity.
+struct FarJoints<'a> {
     /// All the segments in one tree, for d_min.
     bone_tree: BoneTree,
-    /// The segments keyed by joint, for each d_j (a descent each, instead of a scan of
-    /// every bone, or of the hundreds of child bones of one joint, per vertex).
-    joint_tree: BoneTree,
+    /// Every joint's segments keyed by joint, for each d_j (a descent each, instead of a
+    /// scan of every bone, or of the hundreds of child bones of one joint, per vertex).
+    joint_bones: &'a JointBones,
+    /// Whether the joint has segments among those given.
+    has_segments: Vec<bool>,
     /// Up to [`BOUND_SEGMENTS`] segments of each joint: the distance to the nearest of
     /// them bounds d_j from above.
     bound_segments: Vec<Vec<[DVec3; 2]>>,
@@ -132,10 +138,20 @@ struct FarJoints {
     floor: f64,
 }
 
-impl FarJoints {
-    fn new(segments: &[(u32, DVec3, DVec3)], joint_count: usize, floor: f64) -> Self {
+impl<'a> FarJoints<'a> {
+    /// - `segments`: the segments that count, (joint, start, end) triples.
+    /// - `joint_bones`: segments keyed by joint, of every joint of `segments` with the same
+    ///   segments (and maybe of other joints, which do not count).
+    fn new(
+        segments: &[(u32, DVec3, DVec3)],
+        joint_bones: &'a JointBones,
+        joint_count: usize,
+        floor: f64,
+    ) -> Self {
+        let mut has_segments = vec![false; joint_count];
         let mut bound_segments = vec![Vec::new(); joint_count];
         for &(j, a, b) in segments {
+            has_segments[j as usize] = true;
             let kept: &mut Vec<[DVec3; 2]> = &mut bound_segments[j as usize];
             if kept.len() < BOUND_SEGMENTS {
                 kept.push([a, b]);
@@ -145,7 +161,8 @@ impl FarJoints {
             bone_tree: BoneTree::of_segments(
                 &segments.iter().map(|&(_, a, b)| [a, b]).collect::<Vec<_>>(),
             ),
-            joint_tree: BoneTree::new(segments.iter().copied(), Split::Keys),
+            joint_bones,
+            has_segments,
             bound_segments,
             floor,
         }
@@ -153,8 +170,11 @@ impl FarJoints {
 
     /// d_j: the distance from `p` to the nearest bone segment of `joint` (infinity without).
     fn joint_distance(&self, p: DVec3, joint: u32) -> f64 {
-        self.joint_tree
-            .nearest_distance(p, Keys::Inside(joint, joint + 1), |_, _| true)
+        if self.has_segments[joint as usize] {
+            self.joint_bones.distance(p, joint)
+        } else {
+            f64::INFINITY
+        }
     }
 
     /// Whether a joint of `joints` is far from `p`: the same answer as
@@ -243,7 +263,13 @@ mod tests {
     fn far_joints_match_the_trees() {
         for (file, mesh, skeleton) in crate::fixtures::corpus::welded_humans() {
             let segments = bone_segments(&skeleton);
-            let far = FarJoints::new(&segments, skeleton.len(), NEAR_FLOOR * mesh.diagonal());
+            let joint_bones = JointBones::new(&segments);
+            let far = FarJoints::new(
+                &segments,
+                &joint_bones,
+                skeleton.len(),
+                NEAR_FLOOR * mesh.diagonal(),
+            );
             let all = 0..skeleton.len() as u32;
             let mut far_count = 0;
             for &p in &mesh.positions {
@@ -266,7 +292,8 @@ mod tests {
             (1, DVec3::new(0.0, 50.0, 0.0), DVec3::new(0.0, 60.0, 0.0)),
         ];
         let floor = 0.04;
-        let far = FarJoints::new(&segments, 2, floor);
+        let joint_bones = JointBones::new(&segments);
+        let far = FarJoints::new(&segments, &joint_bones, 2, floor);
         let reach = FAR_BONE_RATIO * floor;
         let mut checked = 0;
         for x in [-1.5, -1.0, 0.0, 0.3, 1.0, 1.2] {
@@ -285,6 +312,13 @@ mod tests {
             }
         }
         assert_eq!(checked, 6 * 9 * 2 * 3);
+        // The guard counts only the bones of joints that own skin: the tree of every
+        // joint's bones does not bring a bone of another joint back, even at the vertex.
+        let owning = FarJoints::new(&segments[..1], &joint_bones, 2, floor);
+        let on_bone_1 = DVec3::new(0.0, 55.0, 0.0);
+        assert_eq!(owning.joint_distance(on_bone_1, 1), f64::INFINITY);
+        assert!(owning.any_far(on_bone_1, [1]));
+        assert!(!far.any_far(on_bone_1, [1]));
     }
 
     #[test]
@@ -320,7 +354,12 @@ mod tests {
             }
         }
         let before = weights.clone();
-        let changed = guard_far_bones(&decomposition, &skeleton, &mut weights);
+        let changed = guard_far_bones(
+            &decomposition,
+            &skeleton,
+            &JointBones::new(&segments),
+            &mut weights,
+        );
         assert_eq!(changed, (0..n).filter(|&v| near_root(v)).count());
         for v in 0..n {
             let row: Vec<(u32, f64)> = weights.row(v).collect();

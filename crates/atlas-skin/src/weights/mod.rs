@@ -95,6 +95,7 @@ pub mod surface_weights;
 
 use crate::decomposition::{BoundaryKind, Decomposition};
 use crate::overlap::Overlaps;
+use crate::skeleton::bones::{bone_segments, JointBones};
 use atlas_skin_runtime::Skeleton;
 use blend::Blend;
 use chains::{blend_vertices, region_trees};
@@ -148,14 +149,16 @@ pub fn compute_weights(
         inactive_soft_joints,
     } = region_weights(decomposition, skeleton, overlaps, blend)?;
     let owns_skin: Vec<bool> = decomposition.joints.iter().map(|d| d.owns_skin).collect();
+    let joint_bones = JointBones::new(&bone_segments(skeleton));
     let sibling_blend_vertices = merge_sibling_blends(
         skeleton,
         &decomposition.surface.positions,
+        &joint_bones,
         &owns_skin,
         &leaf_patches,
         &mut weights,
     );
-    let far_bone_vertices = guard_far_bones(decomposition, skeleton, &mut weights);
+    let far_bone_vertices = guard_far_bones(decomposition, skeleton, &joint_bones, &mut weights);
     let mut counts = weight_pieces(decomposition, skeleton, overlaps, &mut weights);
     counts.far_bone_vertices = far_bone_vertices;
     counts.sibling_blend_vertices = sibling_blend_vertices;

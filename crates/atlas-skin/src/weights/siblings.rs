@@ -14,7 +14,7 @@
 //!   f_jk = 1 − β(clamp((d_a / min(d_j, d_k) − ρ₀) / (ρ₁ − ρ₀), 0, 1)),
 //!
 //! with w the vertex's weights of steps 1–3, d_x the distance from the vertex to the nearest
-//! bone segment of joint x ([`bone_segments`]), β the transition function of §4
+//! bone segment of joint x ([`JointBones::distance`]), β the transition function of §4
 //! ([`super::blend::beta`]), s = [`SHARE`], m₀ = [`TAIL`], ρ₀ = [`NEAR_RATIO`], ρ₁ =
 //! [`FAR_RATIO`]. On a midline (w_j = w_k = ½) each gives s/2 of its weight. A common
 //! weight below m₀ is the tail of an ordinary transition that reaches a sibling's bone, and
@@ -33,8 +33,7 @@
 
 use super::blend::beta;
 use super::surface_weights::SurfaceWeights;
-use crate::skeleton::bone_tree::{BoneTree, Keys, Split};
-use crate::skeleton::bones::bone_segments;
+use crate::skeleton::bones::JointBones;
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
 
@@ -56,61 +55,68 @@ pub const FAR_RATIO: f64 = 1.6;
 /// returns how many vertices changed.
 ///
 /// - `positions`: the vertices of the rows of `weights`.
+/// - `joint_bones`: the bone segments of `skeleton` keyed by joint, for the d_x.
 /// - `owns_skin`: per joint, whether it may take weight (an ancestor that owns no skin
 ///   takes none).
 /// - `sliding`: joints whose blends are left alone (leaf patches).
 pub fn merge_sibling_blends(
     skeleton: &Skeleton,
     positions: &[DVec3],
+    joint_bones: &JointBones,
     owns_skin: &[bool],
     sliding: &[u32],
     weights: &mut SurfaceWeights,
 ) -> usize {
-    let family = Family::new(skeleton, owns_skin, sliding);
-    let mut result = SurfaceWeights {
-        offsets: vec![0],
-        ..SurfaceWeights::default()
-    };
-    let mut changed = 0;
+    let family = Family::new(skeleton, joint_bones, owns_skin, sliding);
     let mut row = Vec::new();
-    for (v, &p) in positions.iter().enumerate() {
+    let merge = |source: &SurfaceWeights, v: usize, row: &mut Vec<(u32, f64)>| {
         row.clear();
-        row.extend(weights.row(v));
-        if family.merge_row(p, &mut row) {
+        row.extend(source.row(v));
+        family.merge_row(positions[v], row)
+    };
+    let Some(first) = (0..positions.len()).find(|&v| merge(weights, v, &mut row)) else {
+        return 0;
+    };
+    // The rows before the first that changes stay as they are.
+    let source = std::mem::take(weights);
+    *weights = source.first_rows(first);
+    let mut changed = 0;
+    for v in first..positions.len() {
+        if merge(&source, v, &mut row) {
             changed += 1;
         }
-        result.extend_row(row.iter().copied());
+        weights.extend_row(row.iter().copied());
     }
-    *weights = result;
     changed
 }
 
 /// The skeleton's tree and bones as the rule needs them.
-struct Family {
+struct Family<'a> {
     parents: Vec<Option<u32>>,
     depths: Vec<u32>,
-    /// The bone segments keyed by joint (a root may have thousands of child bones).
-    bones: BoneTree,
+    bones: &'a JointBones,
     owns_skin: Vec<bool>,
     paired: Vec<bool>,
 }
 
-impl Family {
-    fn new(skeleton: &Skeleton, owns_skin: &[bool], sliding: &[u32]) -> Self {
+impl<'a> Family<'a> {
+    fn new(
+        skeleton: &Skeleton,
+        bones: &'a JointBones,
+        owns_skin: &[bool],
+        sliding: &[u32],
+    ) -> Self {
         let parents: Vec<Option<u32>> = (0..skeleton.len())
             .map(|j| skeleton.parent(j).map(|p| p as u32))
-            .collect();
-        let depths = (0..skeleton.len())
-            .map(|j| skeleton.ancestors(j).count() as u32)
             .collect();
         let mut paired = vec![true; skeleton.len()];
         for &j in sliding {
             paired[j as usize] = false;
         }
         Self {
+            depths: depths(skeleton),
             parents,
-            depths,
-            bones: BoneTree::new(bone_segments(skeleton), Split::Keys),
+            bones,
             owns_skin: owns_skin.to_vec(),
             paired,
         }
@@ -143,8 +149,7 @@ impl Family {
 
     /// d_j: the distance from `p` to the nearest bone segment of joint j.
     fn bone_distance(&self, p: DVec3, j: u32) -> f64 {
-        self.bones
-            .nearest_distance(p, Keys::Inside(j, j + 1), |_, _| true)
+        self.bones.distance(p, j)
     }
 
     /// The rule on one row of (joint, weight) pairs at point p; whether it changed.
@@ -202,9 +207,22 @@ impl Family {
     }
 }
 
+/// Each joint's depth (its number of ancestors), parents first in one pass: walking up
+/// from every joint would cost the square of a chain's length.
+fn depths(skeleton: &Skeleton) -> Vec<u32> {
+    let mut depths = vec![0; skeleton.len()];
+    for j in skeleton.topological_order() {
+        if let Some(p) = skeleton.parent(j) {
+            depths[j] = depths[p] + 1;
+        }
+    }
+    depths
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::skeleton::bones::bone_segments;
     use atlas_skin_runtime::NO_PARENT;
     use glam::Vec3;
 
@@ -242,6 +260,7 @@ mod tests {
         merge_sibling_blends(
             skeleton,
             &[p],
+            &JointBones::new(&bone_segments(skeleton)),
             &vec![true; skeleton.len()],
             sliding,
             &mut weights,
@@ -253,6 +272,65 @@ mod tests {
 
     fn weight(row: &[(u32, f64)], joint: u32) -> f64 {
         row.iter().find(|e| e.0 == joint).map_or(0.0, |e| e.1)
+    }
+
+    #[test]
+    fn depths_count_the_ancestors_with_parents_after_children_and_several_roots() {
+        // Roots 1 and 4; the chain 1 → 3 → 0 → 2 → 6 runs against the index order.
+        let parents = vec![3, NO_PARENT, 0, 1, NO_PARENT, 4, 2];
+        let names = (0..parents.len()).map(|j| format!("j{j}")).collect();
+        let skeleton =
+            Skeleton::from_positions(names, parents, &[Vec3::ZERO; 7]).expect("a forest");
+        let ancestors: Vec<u32> = (0..skeleton.len())
+            .map(|j| skeleton.ancestors(j).count() as u32)
+            .collect();
+        assert_eq!(depths(&skeleton), ancestors);
+        assert_eq!(ancestors, vec![2, 0, 3, 1, 0, 1, 4]);
+    }
+
+    #[test]
+    fn rows_before_and_after_the_first_change_are_kept_in_place() {
+        // The crotch of the first test between vertices whose rows do not change.
+        let skeleton = legs(0.1);
+        let crotch = DVec3::new(0.0, -0.05, 0.05);
+        let (thigh, elsewhere) = (DVec3::new(0.1, -0.5, 0.05), DVec3::new(0.0, 1.0, 0.0));
+        let rows: [&[(u32, f64)]; 4] = [
+            &[(2, 1.0)],
+            &[(2, 0.5), (4, 0.5)],
+            &[(1, 0.7), (0, 0.3)],
+            &[(2, 0.5), (3, 0.5)],
+        ];
+        let positions = [thigh, crotch, elsewhere, thigh];
+        let mut weights = SurfaceWeights {
+            offsets: vec![0],
+            ..SurfaceWeights::default()
+        };
+        for row in rows {
+            weights.extend_row(row.iter().copied());
+        }
+        let joint_bones = JointBones::new(&bone_segments(&skeleton));
+        let owns_skin = vec![true; skeleton.len()];
+        let merge = |weights: &mut SurfaceWeights, positions: &[DVec3]| {
+            merge_sibling_blends(&skeleton, positions, &joint_bones, &owns_skin, &[], weights)
+        };
+        let before = weights.clone();
+        // Without the crotch nothing changes.
+        let mut unchanged = before.first_rows(1);
+        assert_eq!(merge(&mut unchanged, &positions[..1]), 0);
+        assert_eq!(unchanged, before.first_rows(1));
+        assert_eq!(merge(&mut weights, &positions), 1);
+        assert_eq!(weights.vertex_count(), 4);
+        for v in [0, 2, 3] {
+            assert_eq!(
+                weights.row(v).collect::<Vec<_>>(),
+                before.row(v).collect::<Vec<_>>()
+            );
+        }
+        let crotch_row = merged(&skeleton, crotch, rows[1], &[]);
+        let mut row: Vec<(u32, f64)> = weights.row(1).collect();
+        row.sort_by_key(|e| e.0);
+        assert_eq!(row, crotch_row);
+        assert!(weight(&row, 0) > 0.0);
     }
 
     #[test]

@@ -28,6 +28,16 @@ impl SurfaceWeights {
             .zip(self.weights[range].iter().copied())
     }
 
+    /// The first `count` rows.
+    pub(crate) fn first_rows(&self, count: usize) -> Self {
+        let end = self.offsets[count] as usize;
+        Self {
+            offsets: self.offsets[..=count].to_vec(),
+            joints: self.joints[..end].to_vec(),
+            weights: self.weights[..end].to_vec(),
+        }
+    }
+
     pub(crate) fn extend_row(&mut self, row: impl IntoIterator<Item = (u32, f64)>) {
         for (j, w) in row {
             self.joints.push(j);
