@@ -13,10 +13,8 @@ use atlas_skin::mesh::duplicate_faces::remove_duplicate_faces;
 use atlas_skin::mesh::weld::DEFAULT_WELD_TOLERANCE;
 use atlas_skin::overlap::{compute_overlaps, OverlapParams, Overlaps};
 use atlas_skin::pipeline::{skin, SkinInput, SkinParams};
-use atlas_skin::skeleton::bones::{bone_segments, JointBones};
 use atlas_skin::weights::blend::Blend;
 use atlas_skin::weights::compute_weights;
-use atlas_skin::weights::guard::guard_far_bones;
 use atlas_skin::{decompose, weld, DecomposeParams, Decomposition, SurfaceMesh, Topology};
 use atlas_skin_corpus::{data_file, CESIUMMAN, MAKEHUMAN};
 use atlas_skin_io::load_character;
@@ -117,12 +115,8 @@ fn overlap_stage(bencher: Bencher, name: &str) {
 fn weights_stage(bencher: Bencher, name: &str) {
     let c = prepared(name);
     bencher.bench(|| {
-        let (mut weights, _) =
-            compute_weights(&c.decomposition, &c.skeleton, &c.overlaps, Blend::default())
-                .expect("weights");
-        let joint_bones = JointBones::new(&bone_segments(&c.skeleton));
-        guard_far_bones(&c.decomposition, &c.skeleton, &joint_bones, &mut weights);
-        weights
+        compute_weights(&c.decomposition, &c.skeleton, &c.overlaps, Blend::default())
+            .expect("weights")
     });
 }
 
