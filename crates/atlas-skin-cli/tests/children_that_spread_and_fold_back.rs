@@ -10,11 +10,8 @@ mod support;
 
 #[test]
 fn a_pelvis_whose_thighs_part_sideways_is_cut_across_the_waist_bone() {
-    let character = atlas_skin_corpus::data_dir().join("bench/rignet-val/17193.glb");
-    let dir = support::out_dir("children-that-spread-and-fold-back");
-    let (glb, report) = support::skin_with_report(&character, &dir, "17193");
-    let joints = report["decomposition"]["joints"].as_array().unwrap();
-    let pelvis = joints.iter().find(|j| j["name"] == "Jaw").unwrap();
+    let skinned = support::BenchSkin::new("rignet-val/17193", "children-that-spread-and-fold-back");
+    let pelvis = skinned.joint("Jaw");
     assert_eq!(pelvis["status"], "soft", "{pelvis}");
     // The plane's normal is the waist bone's direction, from the waist (0, 0.112, −0.004)
     // to the pelvis (0, 0.042, 0.036); before, (−0.02, −0.75, −0.66).
@@ -28,7 +25,7 @@ fn a_pelvis_whose_thighs_part_sideways_is_cut_across_the_waist_bone() {
     let length = bone.iter().map(|x| x * x).sum::<f64>().sqrt();
     let cosine: f64 = normal.iter().zip(bone).map(|(n, b)| n * b).sum::<f64>() / length;
     assert!(cosine > 0.999, "{pelvis}");
-    let deform = support::deform_random(&character, &glb);
+    let deform = skinned.deform();
     // Measured 0.00767 / 0.0668.
     assert!(deform["mean"].as_f64().unwrap() < 0.0083, "{deform}");
     assert!(deform["max"].as_f64().unwrap() < 0.078, "{deform}");

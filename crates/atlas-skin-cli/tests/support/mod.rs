@@ -66,6 +66,40 @@ pub fn deform_random(reference: &Path, candidate: &Path) -> serde_json::Value {
     figures["deform_random"].clone()
 }
 
+/// A skinned character of the bench: its input file, the written glb and the report.
+pub struct BenchSkin {
+    pub input: PathBuf,
+    pub glb: PathBuf,
+    pub report: serde_json::Value,
+}
+
+impl BenchSkin {
+    /// Skins `bench/NAME.glb` of `../shared/data` (NAME such as `rignet-val/1442`) into the
+    /// output folder of `test`.
+    pub fn new(name: &str, test: &str) -> Self {
+        let input = atlas_skin_corpus::data_dir().join(format!("bench/{name}.glb"));
+        let dir = out_dir(test);
+        let stem = input.file_stem().unwrap().to_str().unwrap().to_string();
+        let (glb, report) = skin_with_report(&input, &dir, &stem);
+        BenchSkin { input, glb, report }
+    }
+
+    /// The decision of the report's decomposition for the joint named `name`.
+    pub fn joint(&self, name: &str) -> &serde_json::Value {
+        self.report["decomposition"]["joints"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|j| j["name"] == name)
+            .unwrap_or_else(|| panic!("no joint {name} in the report"))
+    }
+
+    /// The deform figures against the artist's weights ([`deform_random`]).
+    pub fn deform(&self) -> serde_json::Value {
+        deform_random(&self.input, &self.glb)
+    }
+}
+
 /// Skins `input` (a path under `../shared/data`) into the output folder of `test` and returns
 /// its report's `counts.COUNT` with the deform figures against the input's own weights
 /// ([`deform_random`]).
