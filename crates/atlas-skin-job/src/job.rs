@@ -10,7 +10,7 @@ use crate::settings::{Settings, SettingsError};
 use atlas_skin::pipeline::{skin, SkinError, SkinInput, Skinned};
 use atlas_skin::report::{debug_colors, debug_lines};
 use atlas_skin_io::gltf::{debug_glb, skinned_glb_taking_document, WriteOptions};
-use atlas_skin_io::{Character, IoError, LoadOptions, OutputPlan, TriangleMesh};
+use atlas_skin_io::{Character, Contents, IoError, LoadOptions, OutputPlan, TriangleMesh};
 use glam::Vec3;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
@@ -89,6 +89,17 @@ impl Input {
     pub fn load(&self) -> Result<Character, IoError> {
         match &self.path {
             Some(path) => atlas_skin_io::load_character(path, &self.load),
+            None => Ok(demo_character()),
+        }
+    }
+
+    /// [`Input::load`] without what skinning does not use: a glTF input's stored weights
+    /// and animation keys are not decoded ([`Contents::ForSkinning`]).
+    fn load_for_skinning(&self) -> Result<Character, IoError> {
+        match &self.path {
+            Some(path) => {
+                atlas_skin_io::load_character_with(path, &self.load, Contents::ForSkinning)
+            }
             None => Ok(demo_character()),
         }
     }
@@ -182,7 +193,7 @@ impl SkinJob {
             outputs.paths(),
         )?;
         let params = self.settings.params()?;
-        let mut character = self.input.load()?;
+        let mut character = self.input.load_for_skinning()?;
         let Some(skeleton) = character.skeleton.clone() else {
             return Err(JobError::NoSkeleton {
                 path: character.path.clone(),
