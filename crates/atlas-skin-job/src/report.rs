@@ -163,27 +163,7 @@ impl<'a> SkinReport<'a> {
         let decomposition = &skinned.decomposition;
         let counts = &skinned.counts;
         let weight_counts = &counts.weights;
-        let mut warnings = input_warnings.to_vec();
-        warnings.extend(skinned.warnings.iter().cloned());
-        if !weight_counts.inactive_soft_joints.is_empty() {
-            let names: Vec<&str> = weight_counts
-                .inactive_soft_joints
-                .iter()
-                .map(|&j| decomposition.joints[j as usize].name.as_str())
-                .collect();
-            warnings.push(format!(
-                "{} soft boundaries have no cross-section near their joint and carry no \
-                 weight: {}",
-                names.len(),
-                names.join(", ")
-            ));
-        }
-        if counts.unreferenced_stored_vertices > 0 {
-            warnings.push(format!(
-                "{} stored vertices are used by no triangle: bound to their nearest bone",
-                counts.unreferenced_stored_vertices
-            ));
-        }
+        let warnings = report_warnings(input_warnings, skinned);
         Self {
             counts: ReportCounts {
                 duplicate_faces: counts.duplicate_faces,
@@ -232,6 +212,34 @@ impl<'a> SkinReport<'a> {
     pub fn to_text(&self) -> Result<Vec<u8>, serde_json::Error> {
         serde_json::to_vec_pretty(self)
     }
+}
+
+/// The report's warnings: the reader's (`input_warnings`), the method's, then the soft
+/// joints that carry no weight and the stored vertices no triangle uses.
+fn report_warnings(input_warnings: &[String], skinned: &Skinned) -> Vec<String> {
+    let counts = &skinned.counts;
+    let weight_counts = &counts.weights;
+    let mut warnings = input_warnings.to_vec();
+    warnings.extend(skinned.warnings.iter().cloned());
+    if !weight_counts.inactive_soft_joints.is_empty() {
+        let names: Vec<&str> = weight_counts
+            .inactive_soft_joints
+            .iter()
+            .map(|&j| skinned.decomposition.joints[j as usize].name.as_str())
+            .collect();
+        warnings.push(format!(
+            "{} soft boundaries have no cross-section near their joint and carry no weight: {}",
+            names.len(),
+            names.join(", ")
+        ));
+    }
+    if counts.unreferenced_stored_vertices > 0 {
+        warnings.push(format!(
+            "{} stored vertices are used by no triangle: bound to their nearest bone",
+            counts.unreferenced_stored_vertices
+        ));
+    }
+    warnings
 }
 
 impl ReportDecomposition {
@@ -513,27 +521,8 @@ mod tests {
             .collect::<Vec<_>>());
 
         let counts = &skinned.counts;
-        let mut warnings = input_warnings.to_vec();
-        warnings.extend(skinned.warnings.iter().cloned());
         let weight_counts = &counts.weights;
-        if !weight_counts.inactive_soft_joints.is_empty() {
-            let names: Vec<&str> = weight_counts
-                .inactive_soft_joints
-                .iter()
-                .map(|&j| decomposition.joints[j as usize].name.as_str())
-                .collect();
-            warnings.push(format!(
-                "{} soft boundaries have no cross-section near their joint and carry no weight: {}",
-                names.len(),
-                names.join(", ")
-            ));
-        }
-        if counts.unreferenced_stored_vertices > 0 {
-            warnings.push(format!(
-                "{} stored vertices are used by no triangle: bound to their nearest bone",
-                counts.unreferenced_stored_vertices
-            ));
-        }
+        let warnings = report_warnings(input_warnings, skinned);
         json!({
             "input": input,
             "decomposition": decomposition_json,
