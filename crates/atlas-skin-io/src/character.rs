@@ -129,6 +129,20 @@ pub struct LoadOptions {
     pub weights: Option<PathBuf>,
 }
 
+/// What a reader decodes of a glTF input besides its meshes, skeleton and node rig.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum Contents {
+    /// Also the stored weights ([`Character::reference_weights`]) and the animations'
+    /// keys ([`Character::clips`]), each checked.
+    #[default]
+    Everything,
+    /// Neither: what skinning needs (`atlas-skin skin` replaces the weights and copies the
+    /// animations' bytes as they are). The animations' channels are still walked, so the
+    /// warnings about ignored channels are the same; the weight and key accessors are not
+    /// decoded, so a file with bad values there is skinned instead of refused.
+    ForSkinning,
+}
+
 impl Character {
     /// A character with a mesh and nothing else; readers fill in the rest.
     pub fn new(path: impl Into<PathBuf>, mesh: TriangleMesh) -> Self {

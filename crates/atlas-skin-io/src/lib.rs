@@ -29,7 +29,9 @@ pub mod stl;
 mod text;
 pub mod tgf;
 
-pub use character::{Character, LoadOptions, Material, MeshPart, PartBinding, TriangleMesh};
+pub use character::{
+    Character, Contents, LoadOptions, Material, MeshPart, PartBinding, TriangleMesh,
+};
 pub use error::IoError;
-pub use load::load_character;
+pub use load::{load_character, load_character_with};
 pub use output::{remove_leftover_temporaries, OutputPlan};

@@ -4,7 +4,7 @@
 use crate::text::check_file;
 use crate::{
     bvh, dmat, fbx, gltf, medit, mhskel, mhw, obj, off, ply, rig_info, skeleton_json, stl, tgf,
-    Character, IoError, LoadOptions, TriangleMesh,
+    Character, Contents, IoError, LoadOptions, TriangleMesh,
 };
 use atlas_skin_runtime::{Rig, VertexWeights};
 use glam::Vec3;
@@ -31,6 +31,16 @@ const WEIGHTS_EXTENSIONS: &str = ".dmat or .mhw";
 /// without triangles, a skeleton without joints, weights whose rows do not match the mesh
 /// file, and every reader's own errors.
 pub fn load_character(path: &Path, options: &LoadOptions) -> Result<Character, IoError> {
+    load_character_with(path, options, Contents::Everything)
+}
+
+/// [`load_character`], decoding of a glTF input only `contents` besides its meshes,
+/// skeleton and rig ([`gltf::read_contents`]); other formats are read whole.
+pub fn load_character_with(
+    path: &Path,
+    options: &LoadOptions,
+    contents: Contents,
+) -> Result<Character, IoError> {
     check_file(path)?;
     let extension = extension_of(path);
     if options.group.is_some() && extension != "obj" {
@@ -51,7 +61,7 @@ pub fn load_character(path: &Path, options: &LoadOptions) -> Result<Character, I
             let character = if extension == "fbx" {
                 fbx::read(path)?
             } else {
-                gltf::read(path)?
+                gltf::read_contents(path, contents)?
             };
             let positions = character.mesh.positions.clone();
             (character, positions)

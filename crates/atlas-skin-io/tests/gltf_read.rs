@@ -218,3 +218,46 @@ fn a_byte_order_mark_is_accepted_with_a_warning() {
         assert!(mentions_mark(&marked.warnings), "{:?}", marked.warnings);
     }
 }
+
+/// What skinning reads ([`gltf::read_contents`] with `Contents::ForSkinning`) is what
+/// [`gltf::read`] reads but the stored weights and the animations' keys: the same mesh,
+/// skeleton, rig, warnings (RobotExpressive's animations have channels that are ignored
+/// with a warning) and source document; clips by name without tracks.
+#[test]
+fn reading_for_skinning_skips_only_the_weights_and_the_keys() {
+    let robot = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/data/bench/robotexpressive/RobotExpressive.glb"
+    );
+    let files = GLTF_MODELS
+        .iter()
+        .map(|(model, file)| model_path(model, file))
+        .chain([std::path::PathBuf::from(robot)]);
+    for path in files {
+        let whole = gltf::read(&path).unwrap();
+        let skinning = gltf::read_contents(&path, atlas_skin_io::Contents::ForSkinning).unwrap();
+        let name = path.display();
+        assert_eq!(skinning.mesh, whole.mesh, "{name}");
+        assert_eq!(skinning.skeleton, whole.skeleton, "{name}");
+        assert_eq!(skinning.rig, whole.rig, "{name}");
+        assert_eq!(skinning.warnings, whole.warnings, "{name}");
+        assert_eq!(skinning.file_vertex, whole.file_vertex, "{name}");
+        let (a, b) = (skinning.gltf.unwrap(), whole.gltf.unwrap());
+        assert_eq!(a.document, b.document, "{name}");
+        assert_eq!(a.buffers, b.buffers, "{name}");
+        assert_eq!(a.primitives, b.primitives, "{name}");
+        assert_eq!(
+            (a.skin, a.inverse_binds_cleaned),
+            (b.skin, b.inverse_binds_cleaned)
+        );
+        assert!(skinning.reference_weights.is_none(), "{name}");
+        let names = |clips: &[atlas_skin_runtime::Clip]| -> Vec<String> {
+            clips.iter().map(|c| c.name.clone()).collect()
+        };
+        assert_eq!(names(&skinning.clips), names(&whole.clips), "{name}");
+        assert!(skinning.clips.iter().all(|c| c.tracks.is_empty()), "{name}");
+    }
+    let whole = gltf::read(std::path::Path::new(robot)).unwrap();
+    assert!(whole.reference_weights.is_some() && !whole.clips.is_empty());
+    assert!(whole.warnings.iter().any(|w| w.contains("animations[0]")));
+}

@@ -5,12 +5,12 @@
 //! [`OutputPlan`], checked before any work: complete or untouched, never over an input.
 
 use crate::html::{write_html, HtmlError};
-use crate::report::{skin_report, stage_timings, vertex_ranges};
+use crate::report::{stage_timings, SkinReport};
 use crate::settings::{Settings, SettingsError};
 use atlas_skin::pipeline::{skin, SkinError, SkinInput, Skinned};
 use atlas_skin::report::{debug_colors, debug_lines};
 use atlas_skin_io::gltf::{debug_glb, skinned_glb_taking_document, WriteOptions};
-use atlas_skin_io::{Character, IoError, LoadOptions, OutputPlan, TriangleMesh};
+use atlas_skin_io::{Character, Contents, IoError, LoadOptions, OutputPlan, TriangleMesh};
 use glam::Vec3;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
@@ -92,6 +92,17 @@ impl Input {
             None => Ok(demo_character()),
         }
     }
+
+    /// [`Input::load`] without what skinning does not use: a glTF input's stored weights
+    /// and animation keys are not decoded ([`Contents::ForSkinning`]).
+    fn load_for_skinning(&self) -> Result<Character, IoError> {
+        match &self.path {
+            Some(path) => {
+                atlas_skin_io::load_character_with(path, &self.load, Contents::ForSkinning)
+            }
+            None => Ok(demo_character()),
+        }
+    }
 }
 
 /// The built-in demo character ([`atlas_skin::fixtures::demo`]) as if read from a file named
@@ -114,7 +125,7 @@ pub fn demo_character() -> Character {
 pub struct Outputs {
     /// The skinned glTF binary.
     pub glb: PathBuf,
-    /// The JSON report ([`skin_report`]).
+    /// The JSON report ([`crate::report::skin_report`]).
     pub report: Option<PathBuf>,
     /// The self-contained HTML report ([`crate::html`]).
     pub html: Option<PathBuf>,
@@ -154,17 +165,17 @@ pub struct SkinJob {
     pub input: Input,
     pub settings: Settings,
     pub outputs: Outputs,
-    /// Return the JSON report in the [`JobOutcome`] even when no output needs it (a
-    /// batch's log, the Python binding); without it the report is built only for
-    /// [`Outputs::report`] and [`Outputs::html`].
+    /// Return the JSON report in the [`JobOutcome`] (a batch's log, the Python binding);
+    /// without it the report is built only for [`Outputs::report`] (serialised straight
+    /// to its file) and [`Outputs::html`] (as values).
     pub keep_report: bool,
 }
 
 /// What a finished job tells its caller.
 #[derive(Debug, Clone)]
 pub struct JobOutcome {
-    /// The JSON report, when [`SkinJob::keep_report`] asked for it or an output needed it
-    /// (written when [`Outputs::report`] is given).
+    /// The JSON report as values, when [`SkinJob::keep_report`] asked for it or the HTML
+    /// report needed it. (The file of [`Outputs::report`] is serialised without them.)
     pub report: Option<Value>,
     /// What the method noticed and handled (the report's warnings also hold the reader's).
     pub method_warnings: Vec<String>,
@@ -182,7 +193,7 @@ impl SkinJob {
             outputs.paths(),
         )?;
         let params = self.settings.params()?;
-        let mut character = self.input.load()?;
+        let mut character = self.input.load_for_skinning()?;
         let Some(skeleton) = character.skeleton.clone() else {
             return Err(JobError::NoSkeleton {
                 path: character.path.clone(),
@@ -217,18 +228,23 @@ impl SkinJob {
         timings.insert("write".into(), json!(start.elapsed().as_secs_f64() * 1e3));
 
         let input_name = character.path.display().to_string();
-        let wanted = self.keep_report || outputs.report.is_some() || outputs.html.is_some();
-        let report = wanted.then(|| {
-            let mut report = skin_report(&input_name, &character.warnings, &skinned, timings);
-            if let Some(source) = &character.gltf {
-                report["vertex_ranges"] = vertex_ranges(source);
-            }
-            report
+        let written = outputs.report.is_some();
+        let kept = self.keep_report || outputs.html.is_some();
+        let report = (written || kept).then(|| {
+            SkinReport::new(
+                &input_name,
+                &character.warnings,
+                &skinned,
+                &timings,
+                character.gltf.as_ref(),
+            )
         });
         if let (Some(path), Some(report)) = (&outputs.report, &report) {
-            let text = serde_json::to_string_pretty(report).map_err(JobError::Report)?;
-            plan.write(path, text.as_bytes())?;
+            // Serialised straight from the report, not through its JSON values.
+            let text = report.to_text().map_err(JobError::Report)?;
+            plan.write(path, &text)?;
         }
+        let report = report.filter(|_| kept).map(|report| report.to_value());
         if let Some(path) = &outputs.rig_info {
             let pruned = skinned.weights.pruned(params.max_influences);
             let text = atlas_skin_io::rig_info::to_text(&skeleton, &pruned, &character.file_vertex);
@@ -286,8 +302,8 @@ fn debug_view(skinned: &Skinned, path: &Path) -> Result<Vec<u8>, IoError> {
 mod tests {
     use super::*;
 
-    /// The report is built for the outcome only when asked (`keep_report`) or when an
-    /// output needs it; the glb is the same either way.
+    /// The report is in the outcome only when asked (`keep_report`); written to its file
+    /// it is the same report; the glb is the same either way.
     #[test]
     fn the_report_is_built_when_asked_or_written() {
         let input = concat!(
@@ -309,16 +325,18 @@ mod tests {
                 ..SkinJob::default()
             };
             let outcome = job.run(&mut |_| {}).unwrap();
-            (outcome.report, std::fs::read(glb).unwrap())
+            let written = report.then(|| std::fs::read(dir.join(format!("{name}.json"))).unwrap());
+            (outcome.report, std::fs::read(glb).unwrap(), written)
         };
-        let (none, glb) = run("plain", false, false);
-        let (kept, kept_glb) = run("kept", true, false);
-        let (written, _) = run("written", false, true);
+        let (none, glb, _) = run("plain", false, false);
+        let (kept, kept_glb, _) = run("kept", true, false);
+        let (not_kept, _, written) = run("written", false, true);
         std::fs::remove_dir_all(&dir).unwrap();
-        assert!(none.is_none());
+        assert!(none.is_none() && not_kept.is_none());
         assert_eq!(glb, kept_glb);
         let kept = kept.expect("kept");
         assert!(kept["counts"]["vertices"].as_u64().is_some_and(|n| n > 0));
-        assert_eq!(written.expect("written")["counts"], kept["counts"]);
+        let written: Value = serde_json::from_slice(&written.expect("written")).unwrap();
+        assert_eq!(written["counts"], kept["counts"]);
     }
 }

@@ -3,10 +3,13 @@
 //! counts, how the pieces were weighted, and every warning.
 
 use atlas_skin::pipeline::Skinned;
+use atlas_skin::report::SharedSideReport;
 use atlas_skin::weights::pieces::PieceTreatment;
 use atlas_skin::BoundaryKind;
 use atlas_skin_io::gltf::GltfSource;
+use serde::Serialize;
 use serde_json::{json, Map, Value};
+use std::collections::BTreeMap;
 
 /// Wall time of each stage of the method, in milliseconds, keyed by stage name.
 pub fn stage_timings(skinned: &Skinned) -> Map<String, Value> {
@@ -32,46 +35,197 @@ pub fn skin_report(
     skinned: &Skinned,
     timings: Map<String, Value>,
 ) -> Value {
-    let decomposition = &skinned.decomposition;
-    let mut decomposition_json = json!(decomposition.report());
-    if let Some(joints) = decomposition_json["joints"].as_array_mut() {
-        for (joint, decision) in joints.iter_mut().zip(&decomposition.joints) {
-            let Some(k) = decision.boundary else { continue };
-            let k = k as usize;
-            joint["overlap_width"] = json!(skinned.overlaps.half_widths[k]);
-            if let BoundaryKind::Cut { curve } = &decomposition.boundaries[k].kind {
-                let points: Vec<[f64; 3]> = curve
-                    .iter()
-                    .map(|&v| decomposition.surface.positions[v as usize].to_array())
-                    .collect();
-                joint["curve"] = json!(points);
-            }
-        }
-    }
-    // Region of every stored vertex: that of the first face of its welded vertex.
-    let mut vertex_region = vec![None; decomposition.welded_vertex_count];
-    for (f, t) in decomposition.surface.triangles.iter().enumerate().rev() {
-        for &v in t {
-            if let Some(slot) = vertex_region.get_mut(v as usize) {
-                *slot = Some(decomposition.face_region[f]);
-            }
-        }
-    }
-    decomposition_json["vertex_regions"] = json!(skinned
-        .welded_of_stored
-        .iter()
-        .map(|&w| vertex_region.get(w as usize).copied().flatten())
-        .collect::<Vec<_>>());
+    SkinReport::new(input, input_warnings, skinned, &timings, None).to_value()
+}
 
+/// The JSON report of [`skin_report`] (with `vertex_ranges` when `gltf` is given), ready
+/// to be written without the JSON values: [`SkinReport::to_text`] serialises it straight
+/// to its pretty-printed text, the text of [`SkinReport::to_value`] (keys in the sorted
+/// order of [`serde_json::Map`]: each struct below declares its fields in that order).
+#[derive(Serialize)]
+pub struct SkinReport<'a> {
+    counts: ReportCounts,
+    decomposition: ReportDecomposition,
+    input: &'a str,
+    pieces: ReportPieces,
+    timings_ms: &'a Map<String, Value>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    vertex_ranges: Option<Vec<VertexRange>>,
+    warnings: Vec<String>,
+}
+
+#[derive(Serialize)]
+struct ReportCounts {
+    duplicate_faces: usize,
+    fallback_weighted_vertices: usize,
+    far_bone_vertices: usize,
+    inside_out_pieces: usize,
+    joints: usize,
+    leaf_patches: usize,
+    max_influences: usize,
+    off_carrier_vertices: usize,
+    regions: usize,
+    sibling_blend_vertices: usize,
+    surface_vertices: usize,
+    unreachable_vertices: usize,
+    vertices: usize,
+    welded_vertices: usize,
+}
+
+/// [`DecompositionReport`] with every joint's overlap width and curve and every stored
+/// vertex's region, fields in sorted order.
+#[derive(Serialize)]
+struct ReportDecomposition {
+    cuts: usize,
+    joints: Vec<ReportJoint>,
+    regions: Vec<ReportRegion>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    shared_sides: Vec<SharedSideReport>,
+    skipped: usize,
+    soft: usize,
+    vertex_regions: Vec<Option<u32>>,
+}
+
+/// A [`JointReport`], fields in sorted order, with its overlap width and cut curve.
+#[derive(Serialize)]
+struct ReportJoint {
+    #[serde(skip_serializing_if = "Option::is_none")]
+    curve: Option<Vec<[f64; 3]>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    diameter: Option<f64>,
+    name: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    normal: Option<[f64; 3]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    overlap_width: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    perimeter: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    point: Option<[f64; 3]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    reason: Option<String>,
+    region: Option<u32>,
+    status: &'static str,
+}
+
+/// A [`RegionReport`], fields in sorted order.
+#[derive(Serialize)]
+struct ReportRegion {
+    faces: usize,
+    joint: Option<String>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    joints: Vec<String>,
+    vertices: usize,
+}
+
+#[derive(Serialize)]
+struct ReportPieces {
+    by_treatment: BTreeMap<&'static str, TreatmentCount>,
+    gaps: Vec<LoosePart>,
+    not_decomposed: Vec<LoosePart>,
+    treatments: [&'static str; 5],
+    vertex_treatments: Vec<usize>,
+}
+
+#[derive(Serialize, Default)]
+struct TreatmentCount {
+    pieces: usize,
+    vertices: usize,
+}
+
+/// A piece not decomposed, or a gap of a body piece.
+#[derive(Serialize)]
+struct LoosePart {
+    joint: Option<String>,
+    treatment: &'static str,
+    vertices: usize,
+}
+
+#[derive(Serialize)]
+struct VertexRange {
+    count: usize,
+    first: usize,
+    mesh: usize,
+    node: usize,
+    primitive: usize,
+}
+
+impl<'a> SkinReport<'a> {
+    /// The report of `skinned` (see [`skin_report`]); `gltf`: the source of a glTF input,
+    /// for `vertex_ranges` ([`vertex_ranges`]).
+    pub fn new(
+        input: &'a str,
+        input_warnings: &[String],
+        skinned: &'a Skinned,
+        timings: &'a Map<String, Value>,
+        gltf: Option<&GltfSource>,
+    ) -> Self {
+        let decomposition = &skinned.decomposition;
+        let counts = &skinned.counts;
+        let weight_counts = &counts.weights;
+        let warnings = report_warnings(input_warnings, skinned);
+        Self {
+            counts: ReportCounts {
+                duplicate_faces: counts.duplicate_faces,
+                fallback_weighted_vertices: counts.unreferenced_stored_vertices,
+                far_bone_vertices: weight_counts.far_bone_vertices,
+                inside_out_pieces: counts.inside_out_pieces,
+                joints: counts.joints,
+                leaf_patches: weight_counts.leaf_patches.len(),
+                max_influences: skinned.weights.max_influences(),
+                off_carrier_vertices: weight_counts.off_carrier,
+                regions: decomposition.regions.len(),
+                sibling_blend_vertices: weight_counts.sibling_blend_vertices,
+                surface_vertices: counts.surface_vertices,
+                unreachable_vertices: weight_counts.unreachable,
+                vertices: counts.stored_vertices,
+                welded_vertices: counts.welded_vertices,
+            },
+            decomposition: ReportDecomposition::new(skinned),
+            input,
+            pieces: ReportPieces::new(skinned),
+            timings_ms: timings,
+            vertex_ranges: gltf.map(|source| {
+                source
+                    .primitives
+                    .iter()
+                    .map(|p| VertexRange {
+                        count: p.vertices.len(),
+                        first: p.vertices.start,
+                        mesh: p.mesh,
+                        node: p.node,
+                        primitive: p.primitive,
+                    })
+                    .collect()
+            }),
+            warnings,
+        }
+    }
+
+    /// The report as JSON values (what [`skin_report`] returns).
+    pub fn to_value(&self) -> Value {
+        serde_json::to_value(self).unwrap_or(Value::Null)
+    }
+
+    /// The report's pretty-printed JSON text, `serde_json::to_string_pretty` of
+    /// [`SkinReport::to_value`] (the same bytes; tested), written without the values.
+    pub fn to_text(&self) -> Result<Vec<u8>, serde_json::Error> {
+        serde_json::to_vec_pretty(self)
+    }
+}
+
+/// The report's warnings: the reader's (`input_warnings`), the method's, then the soft
+/// joints that carry no weight and the stored vertices no triangle uses.
+fn report_warnings(input_warnings: &[String], skinned: &Skinned) -> Vec<String> {
     let counts = &skinned.counts;
+    let weight_counts = &counts.weights;
     let mut warnings = input_warnings.to_vec();
     warnings.extend(skinned.warnings.iter().cloned());
-    let weight_counts = &counts.weights;
     if !weight_counts.inactive_soft_joints.is_empty() {
         let names: Vec<&str> = weight_counts
             .inactive_soft_joints
             .iter()
-            .map(|&j| decomposition.joints[j as usize].name.as_str())
+            .map(|&j| skinned.decomposition.joints[j as usize].name.as_str())
             .collect();
         warnings.push(format!(
             "{} soft boundaries have no cross-section near their joint and carry no weight: {}",
@@ -85,29 +239,128 @@ pub fn skin_report(
             counts.unreferenced_stored_vertices
         ));
     }
-    json!({
-        "input": input,
-        "decomposition": decomposition_json,
-        "timings_ms": timings,
-        "counts": {
-            "vertices": counts.stored_vertices,
-            "welded_vertices": counts.welded_vertices,
-            "surface_vertices": counts.surface_vertices,
-            "joints": counts.joints,
-            "regions": decomposition.regions.len(),
-            "unreachable_vertices": weight_counts.unreachable,
-            "fallback_weighted_vertices": counts.unreferenced_stored_vertices,
-            "max_influences": skinned.weights.max_influences(),
-            "leaf_patches": weight_counts.leaf_patches.len(),
-            "far_bone_vertices": weight_counts.far_bone_vertices,
-            "sibling_blend_vertices": weight_counts.sibling_blend_vertices,
-            "off_carrier_vertices": weight_counts.off_carrier,
-            "duplicate_faces": counts.duplicate_faces,
-            "inside_out_pieces": counts.inside_out_pieces,
-        },
-        "pieces": pieces_report(skinned),
-        "warnings": warnings,
-    })
+    warnings
+}
+
+impl ReportDecomposition {
+    fn new(skinned: &Skinned) -> Self {
+        let decomposition = &skinned.decomposition;
+        let report = decomposition.report();
+        let joints = report
+            .joints
+            .into_iter()
+            .zip(&decomposition.joints)
+            .map(|(joint, decision)| {
+                let boundary = decision.boundary.map(|k| k as usize);
+                let curve = match boundary.map(|k| &decomposition.boundaries[k].kind) {
+                    Some(BoundaryKind::Cut { curve }) => Some(
+                        curve
+                            .iter()
+                            .map(|&v| decomposition.surface.positions[v as usize].to_array())
+                            .collect(),
+                    ),
+                    _ => None,
+                };
+                ReportJoint {
+                    curve,
+                    diameter: joint.diameter,
+                    name: joint.name,
+                    normal: joint.normal,
+                    overlap_width: boundary.map(|k| skinned.overlaps.half_widths[k]),
+                    perimeter: joint.perimeter,
+                    point: joint.point,
+                    reason: joint.reason,
+                    region: joint.region,
+                    status: joint.status,
+                }
+            })
+            .collect();
+        let regions = report
+            .regions
+            .into_iter()
+            .map(|region| ReportRegion {
+                faces: region.faces,
+                joint: region.joint,
+                joints: region.joints,
+                vertices: region.vertices,
+            })
+            .collect();
+        ReportDecomposition {
+            cuts: report.cuts,
+            joints,
+            regions,
+            shared_sides: report.shared_sides,
+            skipped: report.skipped,
+            soft: report.soft,
+            vertex_regions: vertex_regions(skinned),
+        }
+    }
+}
+
+/// Region of every stored vertex: that of the first face of its welded vertex.
+fn vertex_regions(skinned: &Skinned) -> Vec<Option<u32>> {
+    let decomposition = &skinned.decomposition;
+    let mut vertex_region = vec![None; decomposition.welded_vertex_count];
+    for (f, t) in decomposition.surface.triangles.iter().enumerate().rev() {
+        for &v in t {
+            if let Some(slot) = vertex_region.get_mut(v as usize) {
+                *slot = Some(decomposition.face_region[f]);
+            }
+        }
+    }
+    skinned
+        .welded_of_stored
+        .iter()
+        .map(|&w| vertex_region.get(w as usize).copied().flatten())
+        .collect()
+}
+
+impl ReportPieces {
+    /// How the pieces were weighted: per treatment the number of pieces and vertices
+    /// (`by_treatment`), every piece that was not decomposed (`not_decomposed`:
+    /// `attached`, `rigid` with its joint, `joints`), every gap of a body piece weighted as
+    /// a whole (`gaps`: the parts no region with joints reaches, with the same
+    /// treatments), and the treatment of every stored vertex (`vertex_treatments`: an
+    /// index into `treatments`, [`TREATMENTS`]).
+    fn new(skinned: &Skinned) -> Self {
+        let decomposition = &skinned.decomposition;
+        let counts = &skinned.counts.weights;
+        let joint_name = |treatment: PieceTreatment| match treatment {
+            PieceTreatment::Rigid(j) => Some(decomposition.joints[j as usize].name.clone()),
+            _ => None,
+        };
+        let mut by_treatment: BTreeMap<&'static str, TreatmentCount> = BTreeMap::new();
+        let mut not_decomposed = Vec::new();
+        for piece in &counts.pieces {
+            let name = TREATMENTS[treatment_index(piece.treatment)];
+            let entry = by_treatment.entry(name).or_default();
+            entry.pieces += 1;
+            entry.vertices += piece.vertices;
+            if piece.treatment != PieceTreatment::Body {
+                not_decomposed.push(LoosePart {
+                    joint: joint_name(piece.treatment),
+                    treatment: name,
+                    vertices: piece.vertices,
+                });
+            }
+        }
+        let gaps = counts
+            .gaps
+            .iter()
+            .map(|gap| LoosePart {
+                joint: joint_name(gap.treatment),
+                treatment: TREATMENTS[treatment_index(gap.treatment)],
+                vertices: gap.vertices.len(),
+            })
+            .collect();
+        ReportPieces {
+            by_treatment,
+            gaps,
+            not_decomposed,
+            treatments: TREATMENTS,
+            vertex_treatments: vertex_treatments(skinned),
+        }
+    }
 }
 
 /// Where the report's per-vertex arrays (`decomposition.vertex_regions`,
@@ -146,54 +399,6 @@ fn treatment_index(treatment: PieceTreatment) -> usize {
         PieceTreatment::Rigid(_) => 2,
         PieceTreatment::Joints => 3,
     }
-}
-
-/// How the pieces were weighted: per treatment the number of pieces and vertices
-/// (`by_treatment`), every piece that was not decomposed (`not_decomposed`: `attached`,
-/// `rigid` with its joint, `joints`), every gap of a body piece weighted as a whole
-/// (`gaps`: the parts no region with joints reaches, with the same treatments), and the
-/// treatment of every stored vertex
-/// (`vertex_treatments`: an index into `treatments`, [`TREATMENTS`]).
-fn pieces_report(skinned: &Skinned) -> Value {
-    let decomposition = &skinned.decomposition;
-    let counts = &skinned.counts.weights;
-    let mut summary = serde_json::Map::new();
-    let joint_name = |treatment: PieceTreatment| match treatment {
-        PieceTreatment::Rigid(j) => Some(decomposition.joints[j as usize].name.clone()),
-        _ => None,
-    };
-    let mut loose = Vec::new();
-    for piece in &counts.pieces {
-        let name = TREATMENTS[treatment_index(piece.treatment)];
-        let entry = summary
-            .entry(name)
-            .or_insert_with(|| json!({"pieces": 0, "vertices": 0}));
-        for (key, add) in [("pieces", 1), ("vertices", piece.vertices)] {
-            entry[key] = json!(entry[key].as_u64().unwrap_or(0) + add as u64);
-        }
-        if piece.treatment != PieceTreatment::Body {
-            let joint = joint_name(piece.treatment);
-            loose.push(json!({"treatment": name, "joint": joint, "vertices": piece.vertices}));
-        }
-    }
-    let gaps: Vec<Value> = counts
-        .gaps
-        .iter()
-        .map(|gap| {
-            json!({
-                "treatment": TREATMENTS[treatment_index(gap.treatment)],
-                "joint": joint_name(gap.treatment),
-                "vertices": gap.vertices.len(),
-            })
-        })
-        .collect();
-    json!({
-        "by_treatment": summary,
-        "not_decomposed": loose,
-        "gaps": gaps,
-        "treatments": TREATMENTS,
-        "vertex_treatments": vertex_treatments(skinned),
-    })
 }
 
 /// The index in [`TREATMENTS`] of every stored vertex: `fallback` when no triangle uses
@@ -274,5 +479,174 @@ mod tests {
             assert_eq!(stored as u64, expected, "{name}");
         }
         assert!(pieces["by_treatment"]["attached"]["vertices"].as_u64() > Some(0));
+    }
+
+    /// The report built as JSON values, as it was before [`SkinReport`] (the reference):
+    /// objects keyed in sorted order by [`serde_json::Map`].
+    fn skin_report_reference(
+        input: &str,
+        input_warnings: &[String],
+        skinned: &Skinned,
+        timings: Map<String, Value>,
+    ) -> Value {
+        let decomposition = &skinned.decomposition;
+        let mut decomposition_json = json!(decomposition.report());
+        if let Some(joints) = decomposition_json["joints"].as_array_mut() {
+            for (joint, decision) in joints.iter_mut().zip(&decomposition.joints) {
+                let Some(k) = decision.boundary else { continue };
+                let k = k as usize;
+                joint["overlap_width"] = json!(skinned.overlaps.half_widths[k]);
+                if let BoundaryKind::Cut { curve } = &decomposition.boundaries[k].kind {
+                    let points: Vec<[f64; 3]> = curve
+                        .iter()
+                        .map(|&v| decomposition.surface.positions[v as usize].to_array())
+                        .collect();
+                    joint["curve"] = json!(points);
+                }
+            }
+        }
+        // Region of every stored vertex: that of the first face of its welded vertex.
+        let mut vertex_region = vec![None; decomposition.welded_vertex_count];
+        for (f, t) in decomposition.surface.triangles.iter().enumerate().rev() {
+            for &v in t {
+                if let Some(slot) = vertex_region.get_mut(v as usize) {
+                    *slot = Some(decomposition.face_region[f]);
+                }
+            }
+        }
+        decomposition_json["vertex_regions"] = json!(skinned
+            .welded_of_stored
+            .iter()
+            .map(|&w| vertex_region.get(w as usize).copied().flatten())
+            .collect::<Vec<_>>());
+
+        let counts = &skinned.counts;
+        let weight_counts = &counts.weights;
+        let warnings = report_warnings(input_warnings, skinned);
+        json!({
+            "input": input,
+            "decomposition": decomposition_json,
+            "timings_ms": timings,
+            "counts": {
+                "vertices": counts.stored_vertices,
+                "welded_vertices": counts.welded_vertices,
+                "surface_vertices": counts.surface_vertices,
+                "joints": counts.joints,
+                "regions": decomposition.regions.len(),
+                "unreachable_vertices": weight_counts.unreachable,
+                "fallback_weighted_vertices": counts.unreferenced_stored_vertices,
+                "max_influences": skinned.weights.max_influences(),
+                "leaf_patches": weight_counts.leaf_patches.len(),
+                "far_bone_vertices": weight_counts.far_bone_vertices,
+                "sibling_blend_vertices": weight_counts.sibling_blend_vertices,
+                "off_carrier_vertices": weight_counts.off_carrier,
+                "duplicate_faces": counts.duplicate_faces,
+                "inside_out_pieces": counts.inside_out_pieces,
+            },
+            "pieces": pieces_report_reference(skinned),
+            "warnings": warnings,
+        })
+    }
+
+    /// The `pieces` of [`skin_report_reference`].
+    fn pieces_report_reference(skinned: &Skinned) -> Value {
+        let decomposition = &skinned.decomposition;
+        let counts = &skinned.counts.weights;
+        let mut summary = serde_json::Map::new();
+        let joint_name = |treatment: PieceTreatment| match treatment {
+            PieceTreatment::Rigid(j) => Some(decomposition.joints[j as usize].name.clone()),
+            _ => None,
+        };
+        let mut loose = Vec::new();
+        for piece in &counts.pieces {
+            let name = TREATMENTS[treatment_index(piece.treatment)];
+            let entry = summary
+                .entry(name)
+                .or_insert_with(|| json!({"pieces": 0, "vertices": 0}));
+            for (key, add) in [("pieces", 1), ("vertices", piece.vertices)] {
+                entry[key] = json!(entry[key].as_u64().unwrap_or(0) + add as u64);
+            }
+            if piece.treatment != PieceTreatment::Body {
+                let joint = joint_name(piece.treatment);
+                loose.push(json!({"treatment": name, "joint": joint, "vertices": piece.vertices}));
+            }
+        }
+        let gaps: Vec<Value> = counts
+            .gaps
+            .iter()
+            .map(|gap| {
+                json!({
+                    "treatment": TREATMENTS[treatment_index(gap.treatment)],
+                    "joint": joint_name(gap.treatment),
+                    "vertices": gap.vertices.len(),
+                })
+            })
+            .collect();
+        json!({
+            "by_treatment": summary,
+            "not_decomposed": loose,
+            "gaps": gaps,
+            "treatments": TREATMENTS,
+            "vertex_treatments": vertex_treatments(skinned),
+        })
+    }
+
+    /// [`SkinReport`] gives the reference's values, and its text is the reference's
+    /// pretty-printed text byte for byte: the demo, the demo in pieces with a stored
+    /// vertex no triangle uses (attached, rigid and fallback treatments), and glTF inputs
+    /// with their vertex ranges (cesiumman; RobotExpressive: rigid meshes under joints).
+    #[test]
+    fn the_report_serialised_directly_is_the_reference_text() {
+        let mut pieces = demo_in_pieces(STEP);
+        pieces.positions.push(Vec3::new(0.0, 1.0, 0.5));
+        let demo = demo_character(STEP);
+        let mut cases = vec![
+            ("demo", demo.positions, demo.triangles, demo.skeleton, None),
+            (
+                "pieces",
+                pieces.positions,
+                pieces.triangles,
+                pieces.skeleton,
+                None,
+            ),
+        ];
+        let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data");
+        for file in [
+            "models/cesiumman/CesiumMan.glb",
+            "bench/robotexpressive/RobotExpressive.glb",
+        ] {
+            let path = std::path::Path::new(data).join(file);
+            let character = atlas_skin_io::load_character(&path, &Default::default())
+                .unwrap_or_else(|e| panic!("{e}"));
+            let skeleton = character.skeleton.clone().expect("skeleton");
+            cases.push((
+                file,
+                character.mesh.positions,
+                character.mesh.triangles,
+                skeleton,
+                character.gltf,
+            ));
+        }
+        for (name, positions, triangles, skeleton, gltf) in cases {
+            let input = SkinInput {
+                positions: &positions,
+                triangles: &triangles,
+                skeleton: &skeleton,
+                end_joints: &[],
+            };
+            let skinned = skin(input, &SkinParams::default(), &mut |_| {}).expect("skinned");
+            let mut timings = stage_timings(&skinned);
+            timings.insert("write".into(), json!(1.25));
+            let warnings = vec!["a reader's warning".to_string()];
+            let mut reference = skin_report_reference(name, &warnings, &skinned, timings.clone());
+            if let Some(source) = &gltf {
+                reference["vertex_ranges"] = vertex_ranges(source);
+            }
+            let report = SkinReport::new(name, &warnings, &skinned, &timings, gltf.as_ref());
+            assert_eq!(report.to_value(), reference, "{name}");
+            let text = report.to_text().expect("text");
+            let expected = serde_json::to_string_pretty(&reference).expect("reference text");
+            assert!(text == expected.as_bytes(), "{name}");
+        }
     }
 }

@@ -26,7 +26,7 @@ pub use bindings::Binding;
 pub use budget::{DECODED_FLOOR_BYTES, DECODED_PER_INPUT_BYTE, MAX_DECODED_BYTES};
 pub use container::{ImageBytes, MAX_LOADED_BYTES};
 pub use debug::debug_glb;
-pub use read::read;
+pub use read::{read, read_contents};
 pub use write::{
     skinned_glb, skinned_glb_taking_document, write_skinned_glb, WriteOptions, MAX_INFLUENCES,
 };

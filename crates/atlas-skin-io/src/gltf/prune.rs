@@ -133,7 +133,45 @@ fn renumber(value: &mut Value, paths: &[&[Step]], new_index: &[Option<usize>]) {
 
 /// True when every extension named in `extensionsUsed` or in an `extensions` object
 /// anywhere in `value` is in [`INDEX_FREE_EXTENSIONS`].
+///
+/// The tree is walked with a stack of its objects and arrays (numbers and strings, most of
+/// a document's values, are never pushed); [`only_index_free_extensions_recursive`], the
+/// reference, gives the same answer.
 fn only_index_free_extensions(value: &Value) -> bool {
+    let known = |name: &str| INDEX_FREE_EXTENSIONS.contains(&name);
+    let is_container = |v: &&Value| matches!(v, Value::Object(_) | Value::Array(_));
+    let mut stack = vec![value];
+    while let Some(value) = stack.pop() {
+        match value {
+            Value::Object(map) => {
+                for (key, child) in map {
+                    let names_known = match (key.as_str(), child) {
+                        ("extensions", Value::Object(extensions)) => {
+                            extensions.keys().all(|k| known(k))
+                        }
+                        ("extensionsUsed", Value::Array(names)) => {
+                            names.iter().all(|n| n.as_str().is_some_and(known))
+                        }
+                        _ => true,
+                    };
+                    if !names_known {
+                        return false;
+                    }
+                    if is_container(&child) {
+                        stack.push(child);
+                    }
+                }
+            }
+            Value::Array(items) => stack.extend(items.iter().filter(is_container)),
+            _ => {}
+        }
+    }
+    true
+}
+
+/// [`only_index_free_extensions`] by recursion over every value (the reference).
+#[cfg(test)]
+fn only_index_free_extensions_recursive(value: &Value) -> bool {
     let known = |name: &str| INDEX_FREE_EXTENSIONS.contains(&name);
     match value {
         Value::Object(map) => map.iter().all(|(key, child)| {
@@ -144,9 +182,9 @@ fn only_index_free_extensions(value: &Value) -> bool {
                 }
                 _ => true,
             };
-            names_known && only_index_free_extensions(child)
+            names_known && only_index_free_extensions_recursive(child)
         }),
-        Value::Array(items) => items.iter().all(only_index_free_extensions),
+        Value::Array(items) => items.iter().all(only_index_free_extensions_recursive),
         _ => true,
     }
 }
@@ -446,5 +484,49 @@ mod tests {
                 unchanged
             );
         }
+    }
+
+    /// The walk with a stack answers as the recursion does: documents with known and unknown
+    /// extensions at the root, deep in objects and arrays, in `extensionsUsed` (also with a
+    /// non-string name), in extras, and the corpus's glTF documents.
+    #[test]
+    fn the_stack_walk_answers_as_the_recursion() {
+        let mut documents = vec![
+            json!({}),
+            json!([]),
+            json!(3),
+            json!({"extensionsUsed": ["KHR_materials_unlit"]}),
+            json!({"extensionsUsed": ["EXT_mesh_gpu_instancing"]}),
+            json!({"extensionsUsed": [7]}),
+            json!({"extensionsUsed": "KHR_materials_unlit"}),
+            json!({"extensions": "not an object"}),
+            json!({"nodes": [{"extensions": {"KHR_lights_punctual": {"light": 0}}}]}),
+            json!({"nodes": [{"extensions": {"EXT_mesh_gpu_instancing": {}}}]}),
+            json!({"a": [[[{"b": {"extensions": {"VRM": {}}}}]]], "c": [1, "x", null]}),
+            json!({"a": [[[{"b": {"extensions": {"VRM": {}, "X": {}}}}]]]}),
+            json!({"asset": {"extras": {"extensions": {"unknown": 1}}}}),
+            json!({"meshes": [{"primitives": [{"extensions": {}}]}], "x": [{"extensionsUsed": []}]}),
+        ];
+        let corpus = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data");
+        for file in [
+            "models/cesiumman/CesiumMan.glb",
+            "bench/robotexpressive/RobotExpressive.glb",
+            "bench/kaykit/Barbarian.glb",
+        ] {
+            let path = std::path::Path::new(corpus).join(file);
+            if let Ok(character) = crate::gltf::read(&path) {
+                documents.extend(character.gltf.map(|g| g.document));
+            }
+        }
+        assert!(documents.len() > 14, "no corpus document read");
+        for document in &documents {
+            assert_eq!(
+                only_index_free_extensions(document),
+                only_index_free_extensions_recursive(document),
+                "{document}"
+            );
+        }
+        assert!(!only_index_free_extensions(&documents[4]));
+        assert!(only_index_free_extensions(&documents[8]));
     }
 }

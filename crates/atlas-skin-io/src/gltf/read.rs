@@ -11,7 +11,7 @@ use super::container::read_container;
 use super::document::Document;
 use super::nodes::{unique_node_names, NodeTree};
 use super::{GltfSource, PrimitiveSource};
-use crate::{Character, IoError, TriangleMesh};
+use crate::{Character, Contents, IoError, TriangleMesh};
 use atlas_skin_runtime::{Skeleton, VertexWeights, NO_PARENT};
 use glam::{Mat4, Vec3};
 use serde_json::Value;
@@ -38,6 +38,15 @@ use std::path::Path;
 /// [`IoError`] naming the file and the problem for anything malformed: containers,
 /// JSON, out-of-range accessors or indices, non-finite positions, node cycles.
 pub fn read(path: &Path) -> Result<Character, IoError> {
+    read_contents(path, Contents::Everything)
+}
+
+/// [`read`], decoding only `contents` besides the meshes, the skeleton and the rig: with
+/// [`Contents::ForSkinning`] the character has no reference weights and its clips no
+/// tracks (the animations' channels are walked for the same warnings and channel errors;
+/// their keys and the stored weights are neither decoded nor checked).
+pub fn read_contents(path: &Path, contents: Contents) -> Result<Character, IoError> {
+    let everything = contents == Contents::Everything;
     let mut container = read_container(path)?;
     let budget = DecodeBudget::for_input(container.input_bytes);
     let doc = Document {
@@ -90,14 +99,17 @@ pub fn read(path: &Path) -> Result<Character, IoError> {
         Some(_) => {
             let joint_names = joints.iter().map(|&n| names[n].clone()).collect();
             let skeleton = read_skeleton(&doc, &tree, &joints, binds, joint_names)?;
-            let weights = read_reference_weights(&doc, &geometry.blocks, &joints)?;
+            let weights = match everything {
+                true => read_reference_weights(&doc, &geometry.blocks, &joints)?,
+                false => None,
+            };
             inverse_binds_cleaned = !cleaned.is_empty();
             (Some(skeleton), weights)
         }
         None => (None, None),
     };
     let rig = read_rig(&tree, names, &joints);
-    let clips = read_clips(&doc, &mut warnings)?;
+    let clips = read_clips(&doc, &mut warnings, everything)?;
     let mut character = Character::new(path, geometry.mesh);
     character.skeleton = skeleton;
     character.reference_weights = reference_weights;
