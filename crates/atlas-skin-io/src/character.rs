@@ -136,10 +136,10 @@ pub enum Contents {
     /// keys ([`Character::clips`]), each checked.
     #[default]
     Everything,
-    /// Neither: what skinning needs (`atlas-skin skin` replaces the weights and copies the
-    /// animations' bytes as they are). The animations' channels are still walked, so the
-    /// warnings about ignored channels are the same; the weight and key accessors are not
-    /// decoded, so a file with bad values there is skinned instead of refused.
+    /// What skinning needs: all but the stored weights, which `atlas-skin skin` replaces
+    /// (their accessors are not decoded, so bad values there do not stop it). The
+    /// animations' keys are read and checked as for [`Contents::Everything`]: the skinned
+    /// file copies them, and a bad key would make it invalid.
     ForSkinning,
 }
 

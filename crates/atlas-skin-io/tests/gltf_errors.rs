@@ -227,6 +227,22 @@ fn broken_files() -> Vec<(&'static str, Vec<u8>, Kind, &'static str)> {
             Kind::Invalid,
             "skins[0].joints has node 7",
         ),
+        (
+            // The animation's first two key times swapped: the skinned file would copy them.
+            "keys.gltf",
+            edited(&|j| {
+                use base64::Engine;
+                let engine = base64::engine::general_purpose::STANDARD;
+                let uri = j["buffers"][3]["uri"].as_str().unwrap();
+                let (head, data) = uri.split_once(',').unwrap();
+                let mut bytes = engine.decode(data).unwrap();
+                let (first, second) = bytes[..8].split_at_mut(4);
+                first.swap_with_slice(second);
+                j["buffers"][3]["uri"] = json!(format!("{head},{}", engine.encode(&bytes)));
+            }),
+            Kind::Invalid,
+            "key times are not finite and ascending",
+        ),
         ("empty.glb", Vec::new(), Kind::Empty, "empty"),
     ]
 }
@@ -243,19 +259,23 @@ fn broken_inputs_give_clear_errors() {
     let folder = dir.join("folder.glb");
     std::fs::create_dir_all(&folder).unwrap();
     cases.push((folder, Kind::IsDirectory, "directory"));
+    // What `skin` reads (all but the stored weights) refuses the same files.
+    let skinning = |path: &Path| gltf::read_contents(path, atlas_skin_io::Contents::ForSkinning);
     for (path, kind, needle) in cases {
-        let error = match gltf::read(&path) {
-            Ok(_) => panic!("{} was accepted", path.display()),
-            Err(error) => error,
-        };
-        let message = error.to_string();
-        assert!(
-            kind_matches(&error, kind),
-            "{}: expected {kind:?}, got {error:?}",
-            path.display()
-        );
-        assert!(message.contains(&path.display().to_string()), "{message}");
-        assert!(message.contains(needle), "{message} (expected {needle:?})");
+        for read in [gltf::read, skinning] {
+            let error = match read(&path) {
+                Ok(_) => panic!("{} was accepted", path.display()),
+                Err(error) => error,
+            };
+            let message = error.to_string();
+            assert!(
+                kind_matches(&error, kind),
+                "{}: expected {kind:?}, got {error:?}",
+                path.display()
+            );
+            assert!(message.contains(&path.display().to_string()), "{message}");
+            assert!(message.contains(needle), "{message} (expected {needle:?})");
+        }
     }
 }
 

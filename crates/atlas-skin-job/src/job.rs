@@ -94,7 +94,7 @@ impl Input {
     }
 
     /// [`Input::load`] without what skinning does not use: a glTF input's stored weights
-    /// and animation keys are not decoded ([`Contents::ForSkinning`]).
+    /// are not decoded ([`Contents::ForSkinning`]).
     fn load_for_skinning(&self) -> Result<Character, IoError> {
         match &self.path {
             Some(path) => {

@@ -60,14 +60,8 @@ fn expected_values(property: Property, interpolation: Interpolation, keys: usize
 }
 
 /// Every animation's translation, rotation and scale channels. Morph-target `weights`
-/// channels and channels without a target node are skipped with a warning. Without
-/// `decode_tracks` the channels are walked and checked but their samplers' keys are not
-/// read: every clip has no track (and a duration of 0).
-pub(crate) fn read_clips(
-    doc: &Document,
-    warnings: &mut Vec<String>,
-    decode_tracks: bool,
-) -> Result<Vec<Clip>, IoError> {
+/// channels and channels without a target node are skipped with a warning.
+pub(crate) fn read_clips(doc: &Document, warnings: &mut Vec<String>) -> Result<Vec<Clip>, IoError> {
     let node_count = doc.array("nodes")?.len();
     let mut clips = Vec::new();
     for (index, animation) in doc.array("animations")?.iter().enumerate() {
@@ -113,9 +107,6 @@ pub(crate) fn read_clips(
                     samplers.len()
                 ))
             })?;
-            if !decode_tracks {
-                continue;
-            }
             let track = read_track(
                 doc,
                 sampler,

@@ -41,10 +41,9 @@ pub fn read(path: &Path) -> Result<Character, IoError> {
     read_contents(path, Contents::Everything)
 }
 
-/// [`read`], decoding only `contents` besides the meshes, the skeleton and the rig: with
-/// [`Contents::ForSkinning`] the character has no reference weights and its clips no
-/// tracks (the animations' channels are walked for the same warnings and channel errors;
-/// their keys and the stored weights are neither decoded nor checked).
+/// [`read`], decoding only `contents` besides the meshes, the skeleton, the rig and the
+/// animations: with [`Contents::ForSkinning`] the character has no reference weights (the
+/// stored weights are neither decoded nor checked).
 pub fn read_contents(path: &Path, contents: Contents) -> Result<Character, IoError> {
     let everything = contents == Contents::Everything;
     let mut container = read_container(path)?;
@@ -109,7 +108,7 @@ pub fn read_contents(path: &Path, contents: Contents) -> Result<Character, IoErr
         None => (None, None),
     };
     let rig = read_rig(&tree, names, &joints);
-    let clips = read_clips(&doc, &mut warnings, everything)?;
+    let clips = read_clips(&doc, &mut warnings)?;
     let mut character = Character::new(path, geometry.mesh);
     character.skeleton = skeleton;
     character.reference_weights = reference_weights;
