@@ -90,6 +90,18 @@ pub fn render(
         "Compared with {old_name} (commit {}) → this run (commit {}):",
         old.commit, new.commit
     );
+    if old.settings != new.settings {
+        let seeds = |s: &crate::bench_run::Settings| {
+            format!("{} poses from seed {}", s.poses, s.first_seed)
+        };
+        let _ = writeln!(
+            out,
+            "(the runs' eval settings differ: {} → {}; the changes below mix the weights' and \
+             the poses')",
+            seeds(&old.settings),
+            seeds(&new.settings)
+        );
+    }
     for &(set, table) in tables {
         let changes = character_changes(old, new, set);
         if changes.is_empty() {
@@ -364,5 +376,16 @@ mod tests {
             assert!(text.contains(expected), "missing: {expected}\n\n{text}");
         }
         assert!(!text.contains("now failing"));
+        assert!(!text.contains("settings differ"));
+        // Another seed is said.
+        let mut reseeded = new.clone();
+        reseeded.settings = crate::bench_run::Settings::of_eval_from(10);
+        let text = render(&old, &reseeded, &[(Set::Bench, &table)], "before.json");
+        assert!(
+            text.contains(
+                "the runs' eval settings differ: 10 poses from seed 0 → 10 poses from seed 10"
+            ),
+            "{text}"
+        );
     }
 }

@@ -57,9 +57,14 @@ pub fn render(
              on the cores makes times noisy; use `--jobs 1` on a quiet machine for timing)"
             ))
     );
+    let whose = if *s == crate::bench_run::Settings::of_eval() {
+        "`eval`'s defaults, which are BASELINES.md's"
+    } else {
+        "`eval`'s defaults but the seeds (`--seed`; BASELINES.md's are 0 to 9)"
+    };
     let _ = writeln!(
         out,
-        "Settings: `eval`'s defaults, which are BASELINES.md's: {} random poses (seeds {} to \
+        "Settings: {whose}: {} random poses (seeds {} to \
          {}), every joint turned about a random axis by up to {}° in its own frame, LBS; \
          *deform* = vertex distance to the artist-weighted pose over the rest bounding-box \
          diagonal, mean and max over vertices and poses; *L1* = per-vertex Σ|w_ref − w|, \
@@ -623,5 +628,24 @@ mod tests {
         assert_eq!(change(None, Some(0.1)), "—");
         assert_eq!(opt(None, 3), "—");
         assert_eq!(percent(0.4219), "42.2%");
+    }
+
+    #[test]
+    fn another_seed_is_named_on_the_page() {
+        let table = parse_bench_baselines(SAMPLE).unwrap();
+        let models = BaselineTable {
+            tools: Vec::new(),
+            characters: Vec::new(),
+        };
+        let mut run = run("abc1234", vec![scored("rignet-val/1.glb", 0.01, 0.1, 0)]);
+        run.settings = crate::bench_run::Settings::of_eval_from(10);
+        let page = render(&run, &table, &models, true);
+        assert!(
+            page.contains(
+                "`eval`'s defaults but the seeds (`--seed`; BASELINES.md's are 0 to 9): 10 \
+                 random poses (seeds 10 to 19)"
+            ),
+            "{page}"
+        );
     }
 }

@@ -31,12 +31,17 @@ pub struct Settings {
 }
 
 impl Settings {
-    /// `eval`'s defaults, which the benchmark does not override.
+    /// `eval`'s defaults, which the benchmark does not override but for the first seed.
     pub fn of_eval() -> Self {
+        Self::of_eval_from(EvalOptions::default().seed)
+    }
+
+    /// `eval`'s defaults with the poses' seeds from `first_seed` on.
+    pub fn of_eval_from(first_seed: u64) -> Self {
         let o = EvalOptions::default();
         Self {
             poses: o.poses,
-            first_seed: o.seed,
+            first_seed,
             max_angle_degrees: f64::from(o.max_angle.to_degrees()).round(),
             anim_frames: o.anim_frames,
             bleeding_radius: o.bleeding_radius,
@@ -174,13 +179,15 @@ impl SkinFacts {
     }
 }
 
-/// Runs every character on a pool of `jobs` threads, each writing its files under `work`;
-/// `progress` is called as each one ends. Results are in the order of `characters`.
+/// Runs every character on a pool of `jobs` threads, each writing its files under `work`
+/// and judged under the random poses of `settings`; `progress` is called as each one ends.
+/// Results are in the order of `characters`.
 pub fn run_all(
     exe: &Path,
     characters: &[Character],
     work: &Path,
     jobs: usize,
+    settings: &Settings,
     progress: &(dyn Fn(&CharacterResult) + Sync),
 ) -> Result<Vec<CharacterResult>> {
     let pool = rayon::ThreadPoolBuilder::new()
@@ -191,7 +198,7 @@ pub fn run_all(
         characters
             .par_iter()
             .map(|character| {
-                let result = run_character(exe, character, work);
+                let result = run_character(exe, character, work, settings);
                 progress(&result);
                 result
             })
@@ -200,8 +207,13 @@ pub fn run_all(
 }
 
 /// Skins and judges one character; never fails: a failure is the result.
-pub fn run_character(exe: &Path, character: &Character, work: &Path) -> CharacterResult {
-    let outcome = match score(exe, character, work) {
+pub fn run_character(
+    exe: &Path,
+    character: &Character,
+    work: &Path,
+    settings: &Settings,
+) -> CharacterResult {
+    let outcome = match score(exe, character, work, settings.first_seed) {
         Ok(scored) => Outcome::Scored(Box::new(scored)),
         Err((stage, error)) => Outcome::Failed {
             stage: stage.to_string(),
@@ -218,7 +230,7 @@ pub fn run_character(exe: &Path, character: &Character, work: &Path) -> Characte
 
 type Staged<T> = std::result::Result<T, (&'static str, anyhow::Error)>;
 
-fn score(exe: &Path, character: &Character, work: &Path) -> Staged<Scored> {
+fn score(exe: &Path, character: &Character, work: &Path, first_seed: u64) -> Staged<Scored> {
     let stem = work
         .join(match character.set {
             Set::Bench => "bench",
@@ -242,6 +254,7 @@ fn score(exe: &Path, character: &Character, work: &Path) -> Staged<Scored> {
         &candidate,
         character.prune_reference,
         WORST_VERTICES,
+        first_seed,
     )
     .map_err(|e| ("eval", e))?;
     Ok(Scored {
@@ -428,7 +441,7 @@ pub(crate) mod tests {
             .collect();
         assert_eq!(characters.len(), 2);
         let work = std::env::temp_dir().join(format!("bench-run-{}", std::process::id()));
-        let results = run_all(&exe, &characters, &work, 2, &|_| {}).unwrap();
+        let results = run_all(&exe, &characters, &work, 2, &Settings::of_eval(), &|_| {}).unwrap();
         for result in &results {
             let s = result.scored().unwrap_or_else(|| panic!("{result:?}"));
             assert_eq!(s.evaluation.matched, s.evaluation.vertices);
@@ -449,7 +462,7 @@ pub(crate) mod tests {
         std::fs::write(&text, "not a glb").unwrap();
         broken.skin_args = vec![text.clone().into_os_string()];
         broken.input = text;
-        let result = run_character(&exe, &broken, &work);
+        let result = run_character(&exe, &broken, &work, &Settings::of_eval());
         match &result.outcome {
             Outcome::Failed { stage, reason } => {
                 assert_eq!(stage, "skin");

@@ -148,15 +148,16 @@ pub fn run_skin(
     })
 }
 
-/// `atlas-skin eval REFERENCE_ARGS CANDIDATE --json --worst WORST [--prune-reference N]`,
-/// with `eval`'s default settings (those of BASELINES.md: 10 random poses from seed 0, up
-/// to 60° per joint, LBS and DQS, 8 animation frames).
+/// `atlas-skin eval REFERENCE_ARGS CANDIDATE --json --worst WORST --seed FIRST_SEED
+/// [--prune-reference N]`, with `eval`'s other default settings (those of BASELINES.md: 10
+/// random poses, from seed 0 there, up to 60° per joint, LBS and DQS, 8 animation frames).
 pub fn run_eval(
     exe: &Path,
     reference_args: &[OsString],
     candidate: &Path,
     prune_reference: Option<u16>,
     worst: usize,
+    first_seed: u64,
 ) -> Result<Evaluation> {
     let mut args: Vec<OsString> = vec!["eval".into()];
     args.extend_from_slice(reference_args);
@@ -165,6 +166,8 @@ pub fn run_eval(
         "--json".into(),
         "--worst".into(),
         worst.to_string().into(),
+        "--seed".into(),
+        first_seed.to_string().into(),
     ]);
     if let Some(n) = prune_reference {
         args.extend(["--prune-reference".into(), n.to_string().into()]);
