@@ -640,16 +640,18 @@ fn held_bones(
     nearest_joint: &(dyn Fn(DVec3) -> Option<u32> + Sync),
 ) -> Vec<(u32, DVec3, DVec3)> {
     let held = held_bones_counting(surface, vertices, faces, segments, samples_inside);
-    if !held.weakly {
+    if !held.weakly || held.segments.is_empty() {
         return held.segments;
     }
     let nearest: Vec<Option<u32>> = vertices
         .iter()
         .map(|&v| nearest_joint(surface.positions[v as usize]))
         .collect();
+    let nearest_to_half =
+        |joint: u32| 2 * nearest.iter().filter(|&&n| n == Some(joint)).count() >= nearest.len();
     held.segments
         .into_iter()
-        .filter(|&(j, _, _)| 2 * nearest.iter().filter(|&&n| n == Some(j)).count() >= nearest.len())
+        .filter(|&(joint, _, _)| nearest_to_half(joint))
         .collect()
 }
 
