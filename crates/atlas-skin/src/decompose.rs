@@ -51,7 +51,14 @@ pub fn decompose(
     let vertex_snap = vertex_snap_distances(mesh, topology, params.snap_fraction);
     let bones = BoneIndex::new(joint_pairs(skeleton, &positions), &positions);
     let plans = plan_joints(
-        mesh, &spheres, skeleton, &positions, &bones, &overrides, params,
+        mesh,
+        &topology.vertex_component,
+        &spheres,
+        skeleton,
+        &positions,
+        &bones,
+        &overrides,
+        params,
     );
     let cut_surface = CutSurface {
         mesh,
@@ -399,6 +406,7 @@ fn boundary_geometry(
         diameter,
         parent_region,
         child_region,
+        leaf_part_past: frame.leaf_part_past,
     }
 }
 

@@ -83,6 +83,10 @@ pub struct Boundary {
     pub parent_region: u32,
     /// Region on the child bone's side.
     pub child_region: u32,
+    /// The joint is a leaf whose part runs on past it for at least its bone's length (rule
+    /// 5 (d) of [`crate::cuts::joint_roles`]): a soft boundary of it is seeded farther
+    /// ([`crate::cuts::joint_roles::JointFrame::leaf_part_past`]).
+    pub leaf_part_past: bool,
 }
 
 /// Why a joint has the boundary it has, for the report.

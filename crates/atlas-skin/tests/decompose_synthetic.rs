@@ -462,7 +462,14 @@ fn joints_on_another_bone_skip_a_search_that_would_find_nothing() {
     let bones = BoneIndex::new(joint_pairs(&skeleton, &positions), &positions);
     let overrides = params.overrides(&skeleton).expect("no overrides");
     let plans = plan_joints(
-        &mesh, &spheres, &skeleton, &positions, &bones, &overrides, &params,
+        &mesh,
+        &topology.vertex_component,
+        &spheres,
+        &skeleton,
+        &positions,
+        &bones,
+        &overrides,
+        &params,
     );
     let surface = CutSurface {
         mesh: &mesh,

@@ -117,6 +117,7 @@ fn decompose_by_hand(
                 .fold(0.0, f64::max),
             parent_region: sides[0],
             child_region: sides[1],
+            leaf_part_past: false,
         });
     }
     let mut regions: Vec<Region> = bound
@@ -146,6 +147,7 @@ fn decompose_by_hand(
             diameter: *diameter,
             parent_region: region,
             child_region: region,
+            leaf_part_past: false,
         });
     }
     let joints = (0..skeleton.len() as u32)

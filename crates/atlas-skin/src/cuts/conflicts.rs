@@ -334,6 +334,7 @@ mod tests {
             surface_distance: 0.1,
             on_mirror_plane,
             mirror_twin: None,
+            leaf_part_past: false,
         })
     }
 
@@ -457,6 +458,7 @@ mod tests {
             };
             JointPlan::Boundary(JointFrame {
                 mirror_twin: twins.then_some(twin),
+                leaf_part_past: false,
                 ..frame
             })
         };

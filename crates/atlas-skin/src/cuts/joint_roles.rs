@@ -46,6 +46,16 @@
 //!    a leg bone pointing down), or a part off the bone that is not the leaf's (a prop
 //!    target beside a hand): the leaf is cut when a closed cut fits and is an end site
 //!    otherwise, never a soft boundary ([`JointPlan::CutOrSkip`]).
+//!    (d) When (a) does not hold, for a joint at any depth: that part (within 60° of u),
+//!    taken on the piece around the leaf's bone (the connected piece of the surface nearest
+//!    to the bone's middle), reaches at least the joint's bone length ℓ from p_J. The joint
+//!    is then cut like (a) and (b), and where no cut fits its soft boundary is seeded
+//!    farther than at other leaves ([`JointFrame::leaf_part_past`]). This finds leaves in the
+//!    skin, where r is about 0 and (b) does not apply: a tail tip in a flat sheet that runs
+//!    on past it, feet whose leaves sit in the ankles. A piece of its own past the joint (a
+//!    head modelled apart over its neck, a bag hanging from a belt) is left to the weighting
+//!    of pieces ([`crate::weights::pieces`]), which binds it whole (docs/measurements.md,
+//!    "Leaves whose part runs on past them").
 //!    Otherwise it is an end site (a fingertip cap reaches about 1.4–1.7 r): no boundary.
 //! 6. Twist and helper joints on a straight bone are chain joints with collinear bones: they
 //!    are cut perpendicular to the bone (the cone search), and the weights stage blends the
@@ -105,6 +115,11 @@ pub struct JointFrame {
     /// other side's knee of a knee. A joint keeps its cut only when its twin gets one
     /// ([`crate::cuts::conflicts`]).
     pub mirror_twin: Option<u32>,
+    /// A leaf whose part runs on past it for at least its bone's length (rule 5 (d)). Its
+    /// soft boundary, where it gets one, is seeded as far as that of a joint with child
+    /// bones, and across a face that spans its band there too (step 3 of
+    /// [`crate::weights`]): in the skin or in a sheet, its band is as thin as its depth.
+    pub leaf_part_past: bool,
 }
 
 /// What the decomposition does at one joint.
@@ -166,9 +181,12 @@ const SPREAD_MEAN_LENGTH: f64 = std::f64::consts::FRAC_1_SQRT_2;
 const FOLD_BACK_COSINE: f64 = 0.5;
 
 /// Decides, for every joint of `skeleton` (bind positions `positions`, bones `bones`),
-/// whether it gets a boundary; `overrides` has one entry per joint.
+/// whether it gets a boundary; `overrides` has one entry per joint, `pieces` the connected
+/// piece of every vertex of `mesh` ([`crate::mesh::Topology::vertex_component`]).
+#[allow(clippy::too_many_arguments)]
 pub fn plan_joints(
     mesh: &SurfaceMesh,
+    pieces: &[u32],
     spheres: &FaceSpheres,
     skeleton: &Skeleton,
     positions: &[DVec3],
@@ -179,6 +197,7 @@ pub fn plan_joints(
     let symmetry = infer_symmetry_plane(skeleton, positions, params.symmetry_tolerance);
     let rig = Rig {
         mesh,
+        pieces,
         spheres,
         skeleton,
         positions,
@@ -199,6 +218,8 @@ pub fn plan_joints(
 /// What every joint's rules read: the surface, the skeleton and facts derived from both.
 struct Rig<'a> {
     mesh: &'a SurfaceMesh,
+    /// The connected piece of every vertex.
+    pieces: &'a [u32],
     spheres: &'a FaceSpheres,
     skeleton: &'a Skeleton,
     positions: &'a [DVec3],
@@ -256,10 +277,12 @@ impl Rig<'_> {
                 return plan;
             }
         }
+        let mut frame = frame;
         if self.children[j].is_empty() {
             let end_site = "end site: the surface does not run on past the joint";
             match leaf_part(
                 self.mesh,
+                self.pieces,
                 self.spheres,
                 &frame,
                 |radius| self.bones.near(j, self.positions[j], radius),
@@ -267,6 +290,7 @@ impl Rig<'_> {
                 self.params.leaf_extent_ratio,
             ) {
                 LeafPart::Owned => {}
+                LeafPart::PastBone => frame.leaf_part_past = true,
                 LeafPart::OffAxis => {
                     return JointPlan::CutOrSkip(
                         frame,
@@ -323,6 +347,7 @@ impl Rig<'_> {
             frame: JointFrame {
                 on_mirror_plane,
                 mirror_twin: self.twins[j],
+                leaf_part_past: false,
                 position: p,
                 upper,
                 lower,
@@ -387,20 +412,23 @@ fn branching_plan(frame: &JointFrame, child_vectors: &[DVec3]) -> Option<JointPl
 enum LeafPart {
     /// The surface runs on past the joint, along its bone: (a) or (b).
     Owned,
+    /// It runs on past the joint along its bone for at least the bone's length: (d).
+    PastBone,
     /// It runs on past the joint only across its bone: (c).
     OffAxis,
     /// An end site.
     None,
 }
 
-/// Rule 5 of the module documentation for the leaf of `frame`. `other_bones(radius)`: the
-/// bones not at the leaf within `radius` of it, as segments; `orientation` as from
-/// [`orientation_sign`].
+/// Rule 5 of the module documentation for the leaf of `frame`. `pieces`: the connected piece
+/// of every vertex; `other_bones(radius)`: the bones not at the leaf within `radius` of it,
+/// as segments; `orientation` as from [`orientation_sign`].
 fn leaf_part(
     mesh: &SurfaceMesh,
+    pieces: &[u32],
     spheres: &FaceSpheres,
     frame: &JointFrame,
-    other_bones: impl FnOnce(f64) -> Vec<[DVec3; 2]>,
+    other_bones: impl Fn(f64) -> Vec<[DVec3; 2]>,
     orientation: f64,
     extent_ratio: f64,
 ) -> LeafPart {
@@ -412,36 +440,61 @@ fn leaf_part(
     if exit_along_bone.is_some_and(|hit| hit.distance >= threshold) {
         return LeafPart::Owned;
     }
+    // (d), on the piece around the leaf's bone: the one nearest to the bone's middle.
+    let bone_piece = spheres
+        .nearest_point(mesh, p - 0.5 * frame.bone_length * upper)
+        .map(|nearest| pieces[mesh.triangles[nearest.face as usize][0] as usize]);
+    if let Some(piece) = bone_piece {
+        let on_piece = Some((pieces, piece));
+        let [past_bone, _] = leaf_reaches(
+            mesh,
+            spheres,
+            p,
+            upper,
+            frame.bone_length,
+            &other_bones,
+            on_piece,
+        );
+        if past_bone {
+            return LeafPart::PastBone;
+        }
+    }
     if radius < INTERIOR_RADIUS * frame.bone_length {
         return LeafPart::None;
     }
-    let reach_threshold = LEAF_REACH_RATIO * radius;
-    // A bone nearer than p to a vertex within ρ of p lies within 2ρ of p (3ρ leaves room
-    // for rounding): the others need no test.
-    let reach_radius = 2.0 * reach_threshold;
-    let near_bones = other_bones(3.0 * reach_radius);
-    let [along, across] = leaf_reach(mesh, spheres, p, upper, &near_bones, reach_radius);
-    if along >= reach_threshold {
-        LeafPart::Owned
-    } else if across >= reach_threshold {
-        LeafPart::OffAxis
-    } else {
-        LeafPart::None
+    match leaf_reaches(
+        mesh,
+        spheres,
+        p,
+        upper,
+        LEAF_REACH_RATIO * radius,
+        other_bones,
+        None,
+    ) {
+        [true, _] => LeafPart::Owned,
+        [false, true] => LeafPart::OffAxis,
+        [false, false] => LeafPart::None,
     }
 }
 
-/// The largest distance from `p` of the surface vertices v within `radius` of it that lie
-/// past it near the unit `direction` and nearer to `p` than to each bone of
-/// `other_bones`: how far the part beyond a leaf joint reaches, within 60° of `direction`
-/// ((v − p) · direction ≥ ½ |v − p|) and within 75° ([`OFF_AXIS_COSINE`]).
-fn leaf_reach(
+/// Whether the part beyond a leaf joint at `p` reaches `reach` from it: whether some
+/// surface vertex v with `reach` ≤ |v − p| ≤ 2 `reach`, nearer to `p` than to each bone of
+/// `other_bones(radius)` (the bones not at the leaf within `radius` of `p`), lies past it
+/// within 60° of the unit `direction` ((v − p) · direction ≥ ½ |v − p|), and whether one
+/// lies past it within 75° ([`OFF_AXIS_COSINE`]).
+fn leaf_reaches(
     mesh: &SurfaceMesh,
     spheres: &FaceSpheres,
     p: DVec3,
     direction: DVec3,
-    other_bones: &[[DVec3; 2]],
-    radius: f64,
-) -> [f64; 2] {
+    reach: f64,
+    other_bones: impl Fn(f64) -> Vec<[DVec3; 2]>,
+    on_piece: Option<(&[u32], u32)>,
+) -> [bool; 2] {
+    let radius = 2.0 * reach;
+    // A bone nearer than p to a vertex within ρ of p lies within 2ρ of p (3ρ leaves room
+    // for rounding): the others need no test.
+    let bones = other_bones(3.0 * radius);
     let mut vertices: Vec<u32> = spheres
         .faces_near(p, radius)
         .into_iter()
@@ -449,24 +502,29 @@ fn leaf_reach(
         .collect();
     vertices.sort_unstable();
     vertices.dedup();
-    let mut reach = [0.0f64; 2];
+    if let Some((pieces, piece)) = on_piece {
+        vertices.retain(|&v| pieces[v as usize] == piece);
+    }
+    let mut found = [false; 2];
     for v in vertices.into_iter().map(|v| mesh.positions[v as usize]) {
         let d = v.distance(p);
         let along = (v - p).dot(direction);
-        if d > radius
+        if d < reach
+            || d > radius
             || along < OFF_AXIS_COSINE * d
-            || other_bones
+            || bones
                 .iter()
                 .any(|&[a, b]| point_segment_distance(v, a, b) <= d)
         {
             continue;
         }
+        found[1] = true;
         if along >= PAST_COSINE * d {
-            reach[0] = reach[0].max(d);
+            found[0] = true;
+            break;
         }
-        reach[1] = reach[1].max(d);
     }
-    reach
+    found
 }
 
 /// Whether at least four of six rays from `p` first meet the surface leaving it (the hit
@@ -707,27 +765,43 @@ mod tests {
     }
 
     /// Rule 5 at the bend of a tube of radius ½ bent by `bend` degrees, the leaf's bone
-    /// coming up the first segment: the second segment is the part past the leaf.
+    /// coming up the first segment: the second segment is the part past the leaf. The bone
+    /// is taken as 4 long, longer than that part (3 and a cap), as a leg bone is longer
+    /// than the foot past its ankle: (d) does not apply.
     fn leaf_part_at_bend(bend: f64) -> LeafPart {
         let (mesh, _) = crate::fixtures::shapes::bent_cylinder(0.5, 3.0, bend, 24, 16);
-        let spheres = FaceSpheres::new(&mesh);
-        let position = DVec3::Y * 3.0;
+        let pieces = vec![0; mesh.vertex_count()];
+        leaf_part_of(&mesh, &pieces, DVec3::Y * 3.0, DVec3::Y, 4.0)
+    }
+
+    /// Rule 5 for a leaf at `position` of `mesh` (pieces `pieces`), its bone of length
+    /// `bone_length` along the unit `upper`, with no other bone near.
+    fn leaf_part_of(
+        mesh: &SurfaceMesh,
+        pieces: &[u32],
+        position: DVec3,
+        upper: DVec3,
+        bone_length: f64,
+    ) -> LeafPart {
+        let spheres = FaceSpheres::new(mesh);
         let frame = JointFrame {
             position,
-            upper: DVec3::Y,
-            lower: DVec3::Y,
-            bone_length: 3.0,
-            surface_distance: spheres.nearest_distance(&mesh, position),
+            upper,
+            lower: upper,
+            bone_length,
+            surface_distance: spheres.nearest_distance(mesh, position),
             on_mirror_plane: false,
             mirror_twin: None,
+            leaf_part_past: false,
         };
         let ratio = crate::DecomposeParams::default().leaf_extent_ratio;
         leaf_part(
-            &mesh,
+            mesh,
+            pieces,
             &spheres,
             &frame,
             |_| Vec::new(),
-            orientation_sign(&mesh),
+            orientation_sign(mesh),
             ratio,
         )
     }
@@ -740,6 +814,54 @@ mod tests {
         assert_eq!(leaf_part_at_bend(90.0), LeafPart::OffAxis);
         // A straight tube ends at its cap: the ray along the bone leaves it a radius away.
         assert_eq!(leaf_part_at_bend(0.0), LeafPart::Owned);
+    }
+
+    /// Rule 5 at a leaf lying just above a flat sheet (a tail modelled as one layer of
+    /// faces in the plane y = 0, 0.4 wide, from z = 0 to z = −`length`), its bone of length
+    /// 1 coming along the sheet from z = 0 to z = −1. With `apart`, the sheet past
+    /// z = −1.05 is a piece of its own (its first row moved there, unjoined).
+    fn leaf_part_on_sheet(length: f64, apart: bool) -> LeafPart {
+        let mut mesh = SurfaceMesh {
+            positions: Vec::new(),
+            triangles: Vec::new(),
+        };
+        let mut pieces = Vec::new();
+        // A strip from z = −`from` to z = −`to`, in rows 0.1 apart, as piece `piece`.
+        let mut strip = |from: f64, to: f64, piece: u32| {
+            let rows = ((to - from) * 10.0).round() as u32;
+            let first = mesh.positions.len() as u32;
+            for i in 0..=rows {
+                let z = -(from + (to - from) * f64::from(i) / f64::from(rows));
+                mesh.positions
+                    .extend([DVec3::new(-0.2, 0.0, z), DVec3::new(0.2, 0.0, z)]);
+                pieces.extend([piece, piece]);
+            }
+            for a in (0..rows).map(|i| first + 2 * i) {
+                mesh.triangles
+                    .extend([[a, a + 1, a + 2], [a + 1, a + 3, a + 2]]);
+            }
+        };
+        if apart {
+            strip(0.0, 1.0, 0);
+            strip(1.05, length, 1);
+        } else {
+            strip(0.0, length, 0);
+        }
+        let position = DVec3::new(0.0, 0.001, -1.0);
+        leaf_part_of(&mesh, &pieces, position, DVec3::NEG_Z, 1.0)
+    }
+
+    #[test]
+    fn a_leaf_in_a_sheet_owns_the_sheet_that_runs_on_past_it_for_its_bones_length() {
+        // The ray along the bone meets no face and the joint lies in the skin (rule 5 (b)
+        // does not apply): only (d) tells a tail tip from the end of the sheet.
+        assert_eq!(leaf_part_on_sheet(2.5, false), LeafPart::PastBone);
+        assert_eq!(leaf_part_on_sheet(2.1, false), LeafPart::PastBone);
+        assert_eq!(leaf_part_on_sheet(1.8, false), LeafPart::None);
+        assert_eq!(leaf_part_on_sheet(1.0, false), LeafPart::None);
+        // A piece of its own past the joint (a head modelled apart over a neck) is left to
+        // the weighting of pieces.
+        assert_eq!(leaf_part_on_sheet(2.5, true), LeafPart::None);
     }
 
     #[test]

@@ -51,8 +51,12 @@ impl SoftSide {
 /// side: rignet-val/3615's ponytail at hair2), the seeds are the ends past the band's
 /// near edge (n·(p − o) > w) of their edges. Where still no vertex qualifies and the
 /// joint has child bones (a coarse mesh whose faces are larger than the section: KayKit's
-/// hips), the seeds are those within d_N + max(D, w), d_N the distance from the joint to
-/// the nearest vertex of the surface. A soft boundary with no
+/// hips) or is a leaf whose part runs on past it for its bone's length
+/// ([`Boundary::leaf_part_past`]), the seeds are those within d_N + max(D, w), d_N the
+/// distance from the joint to the nearest vertex of the surface; for such a leaf, failing
+/// those, the far ends of their edges as above (a tail tip in a flat sheet: its band is as
+/// thin as the joint's depth, 2r, and one face spans it; for joints with child bones this
+/// last step lost on the benchmark, docs/measurements.md). A soft boundary with no
 /// cross-section (diameter 0, or no seed: face bones in a mouth cavity or an eye socket,
 /// whose leaf joints are not seeded farther) is inactive: its joint gets no weight and its
 /// region's other joints keep it.
@@ -93,7 +97,7 @@ pub fn soft_sides(
             let in_region = |v: usize| related.row(v).iter().any(|&(r, _)| r == b.parent_region);
             let seeds = Seeds {
                 vertices: &vertices,
-                beyond_nearest: !children[b.joint as usize].is_empty(),
+                beyond_nearest: !children[b.joint as usize].is_empty() || b.leaf_part_past,
             };
             child_side(d, b, half_width, &owner, &beyond, in_region, &seeds)
         })
@@ -148,7 +152,8 @@ impl<'a> NearVertices<'a> {
 }
 
 /// Where a soft boundary's flood starts: the surface's vertices as points, and whether the
-/// seeds may lie beyond the nearest vertex (a joint with child bones).
+/// seeds may lie beyond the nearest vertex (a joint with child bones, or a leaf whose part
+/// runs on past it).
 struct Seeds<'a> {
     vertices: &'a NearVertices<'a>,
     beyond_nearest: bool,
@@ -203,26 +208,33 @@ fn child_side(
         near.retain(|&v| signed(v as usize) <= half_width);
         near
     };
+    // One face spans the band: the section crosses its edges from the vertices near the
+    // joint to the child side past the band, whose ends seed the flood.
+    let far_ends = |near: &[u32]| -> Vec<u32> {
+        near.iter()
+            .filter(|&&v| in_region(v as usize))
+            .flat_map(|&v| d.topology.neighbors(v as usize).iter().copied())
+            .filter(|&u| signed(u as usize) > half_width)
+            .collect()
+    };
     let near = near_band(seed_radius);
     for &v in &near {
         visit(v, &mut queue);
     }
     if queue.is_empty() {
-        // One face spans the band: the section crosses its edges from the vertices near
-        // the joint to the child side past the band, whose ends seed the flood.
-        for &v in &near {
-            if in_region(v as usize) {
-                for &u in d.topology.neighbors(v as usize) {
-                    if signed(u as usize) > half_width {
-                        visit(u, &mut queue);
-                    }
-                }
-            }
+        for u in far_ends(&near) {
+            visit(u, &mut queue);
         }
     }
     if queue.is_empty() && seeds.beyond_nearest {
-        for v in near_band(seeds.vertices.nearest(b.point) + seed_radius) {
+        let farther = near_band(seeds.vertices.nearest(b.point) + seed_radius);
+        for &v in &farther {
             visit(v, &mut queue);
+        }
+        if queue.is_empty() && b.leaf_part_past {
+            for u in far_ends(&farther) {
+                visit(u, &mut queue);
+            }
         }
     }
     if queue.is_empty() {
