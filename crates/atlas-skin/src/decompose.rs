@@ -432,10 +432,14 @@ fn validate_input(
     skeleton: &Skeleton,
 ) -> Result<(), DecomposeError> {
     skeleton.validate()?;
-    if topology.face_edges.len() != mesh.triangle_count() {
+    if topology.face_edges.len() != mesh.triangle_count()
+        || topology.vertex_component.len() != mesh.vertex_count()
+    {
         return Err(DecomposeError::TopologyMismatch {
             faces: mesh.triangle_count(),
+            vertices: mesh.vertex_count(),
             topology_faces: topology.face_edges.len(),
+            topology_vertices: topology.vertex_component.len(),
         });
     }
     let count = mesh.vertex_count();

@@ -374,6 +374,13 @@ fn invalid_requests_are_rejected() {
         decompose(&mesh, &other, &rig, &DecomposeParams::default()),
         Err(DecomposeError::TopologyMismatch { .. })
     ));
+    // The same faces over one vertex more: the topology's vertices are not the mesh's.
+    let mut more = mesh.clone();
+    more.positions.push(DVec3::ZERO);
+    assert!(matches!(
+        decompose(&more, &topology, &rig, &DecomposeParams::default()),
+        Err(DecomposeError::TopologyMismatch { .. })
+    ));
 }
 
 #[test]

@@ -67,8 +67,16 @@ pub enum DecomposeError {
         value: f64,
         expected: &'static str,
     },
-    #[error("the topology has {topology_faces} faces but the mesh {faces}")]
-    TopologyMismatch { faces: usize, topology_faces: usize },
+    #[error(
+        "the topology has {topology_faces} faces and {topology_vertices} vertices but the mesh \
+         {faces} and {vertices}"
+    )]
+    TopologyMismatch {
+        faces: usize,
+        vertices: usize,
+        topology_faces: usize,
+        topology_vertices: usize,
+    },
     #[error("triangle {face} refers to vertex {vertex}, the mesh has {count}")]
     VertexOutOfRange {
         face: usize,
