@@ -1,6 +1,6 @@
 //! The whole method ([`atlas_skin::pipeline::skin`]) on a bent tube: stages in order,
 //! weights for every stored vertex, a smooth transition at the joint, settings checked
-//! before any work.
+//! before any work; and on a tail modelled as a flat sheet.
 
 use atlas_skin::fixtures::shapes::{bent_cylinder, capsule_chain};
 use atlas_skin::overlap::OverlapError;
@@ -313,4 +313,69 @@ fn many_siblings_on_one_line_are_skinned_with_a_warning() {
     );
     assert_eq!(skinned.weights.vertex_count(), positions.len());
     assert_eq!(skinned.counts.weights.unreachable, 0);
+}
+
+/// A tail modelled as one flat sheet of faces (y = 0, 0.4 wide, from z = 0.5 to z = −3.5,
+/// rows 0.1 apart) over the chain root (z = 0) → tail1 (z = −1.05) → tail2 (z = −2.05),
+/// the joints a thousandth above the sheet and midway between rows. No closed section fits
+/// anywhere: both joints get soft boundaries, whose bands are as thin as the joints' depth
+/// (D = 2r = 0.002) and hold no vertex. The leaf tail2 owns the sheet past it, which runs
+/// on for 1.45 bone lengths (rule 5 (d) of the joint roles), and its boundary is seeded
+/// across the face that spans its band.
+#[test]
+fn a_tail_tip_in_a_flat_sheet_moves_with_its_leaf() {
+    let rows = 40u32;
+    let row_z = |i: u32| 0.5 - 0.1 * f64::from(i);
+    let mesh = SurfaceMesh {
+        positions: (0..=rows)
+            .flat_map(|i| {
+                [
+                    DVec3::new(-0.2, 0.0, row_z(i)),
+                    DVec3::new(0.2, 0.0, row_z(i)),
+                ]
+            })
+            .collect(),
+        triangles: (0..rows)
+            .map(|i| 2 * i)
+            .flat_map(|a| [[a, a + 1, a + 2], [a + 1, a + 3, a + 2]])
+            .collect(),
+    };
+    let joint = |z: f32| Vec3::new(0.0, 0.001, z);
+    let skeleton = Skeleton::from_positions(
+        ["root", "tail1", "tail2"].map(String::from).to_vec(),
+        vec![atlas_skin_runtime::NO_PARENT, 0, 1],
+        &[joint(0.0), joint(-1.05), joint(-2.05)],
+    )
+    .expect("valid skeleton");
+    let (positions, skinned) = skin_with_defaults(&mesh, &skeleton);
+    let tail2 = skinned
+        .decomposition
+        .joints
+        .iter()
+        .position(|j| j.name == "tail2")
+        .expect("tail2");
+    assert!(
+        matches!(
+            skinned.decomposition.joints[tail2].status,
+            atlas_skin::JointStatus::Soft(_)
+        ),
+        "{:?}",
+        skinned.decomposition.joints[tail2].status
+    );
+    let mut past = 0;
+    for (v, p) in positions.iter().enumerate().filter(|(_, p)| p.z < -2.25) {
+        let on_tail2: f32 = skinned
+            .weights
+            .row(v)
+            .filter(|&(j, _)| j as usize == tail2)
+            .map(|(_, w)| w)
+            .sum();
+        assert!(on_tail2 > 0.5, "vertex {v} at {p}: {on_tail2} on tail2");
+        past += 1;
+    }
+    assert_eq!(past, 2 * 13);
+    // tail2's boundary carries weight (tail1's, with no face spanning its band from the
+    // nearest vertices' side, does not; the guard against far bones then gives the sheet
+    // near it to the nearest bones).
+    assert_eq!(skinned.counts.weights.inactive_soft_joints, [1]);
 }
