@@ -1,9 +1,10 @@
 //! Typed reads of glTF accessors (glTF 2.0 §3.6.2), every byte range checked against its
 //! bufferView and buffer before it is read.
 
-use super::document::{opt_str, Document};
+use super::document::{opt_str, Document, Location};
 use crate::IoError;
 use serde_json::Value;
+use std::fmt::Display;
 
 /// An accessor's component type (`accessor.componentType`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -195,7 +196,7 @@ impl Accessor<'_> {
 
 /// Bytes of bufferView `view` and its byteStride, checked against its buffer.
 fn view_bytes<'a>(doc: &Document<'a>, view: usize) -> Result<(&'a [u8], Option<usize>), IoError> {
-    let location = format!("bufferViews[{view}]");
+    let location = Location::item("bufferViews", view);
     let object = doc.item("bufferViews", view)?;
     let buffer = doc.index(object, &location, "buffer")?;
     let offset = doc.opt_index(object, &location, "byteOffset")?.unwrap_or(0);
@@ -227,7 +228,7 @@ fn view_bytes<'a>(doc: &Document<'a>, view: usize) -> Result<(&'a [u8], Option<u
 /// view's stride (tightly packed when `allow_stride` is false or the view has none).
 fn strided<'a>(
     doc: &Document<'a>,
-    location: &str,
+    location: &dyn Display,
     view: usize,
     offset: usize,
     count: usize,
@@ -271,7 +272,7 @@ fn accessor<'a>(
     index: usize,
     expected_type: &str,
 ) -> Result<Accessor<'a>, IoError> {
-    let location = format!("accessors[{index}]");
+    let location = Location::item("accessors", index);
     let object = doc.item("accessors", index)?;
     let code = object.get("componentType").and_then(Value::as_u64);
     let component = code.and_then(ComponentType::from_code).ok_or_else(|| {
@@ -332,7 +333,7 @@ fn accessor<'a>(
 /// The `sparse` part of an accessor with `count` elements.
 fn sparse_part<'a>(
     doc: &Document<'a>,
-    location: &str,
+    location: &dyn Display,
     sparse: &Value,
     count: usize,
     element_size: usize,
@@ -387,7 +388,7 @@ fn sparse_part<'a>(
 }
 
 /// Prefixes the message of an [`IoError::Invalid`] with what the accessor is used as.
-fn used_as(error: IoError, role: &str) -> IoError {
+fn used_as(error: IoError, role: &dyn Display) -> IoError {
     match error {
         IoError::Invalid { path, message } => IoError::Invalid {
             path,
@@ -404,7 +405,7 @@ pub(crate) fn read_floats(
     doc: &Document,
     index: usize,
     expected_type: &str,
-    role: &str,
+    role: &dyn Display,
 ) -> Result<Vec<f32>, IoError> {
     let accessor = accessor(doc, index, expected_type).map_err(|e| used_as(e, role))?;
     doc.charge(accessor.decoded_bytes(), role)?;
@@ -423,7 +424,7 @@ pub(crate) fn read_uints(
     doc: &Document,
     index: usize,
     expected_type: &str,
-    role: &str,
+    role: &dyn Display,
 ) -> Result<Vec<u32>, IoError> {
     let accessor = accessor(doc, index, expected_type).map_err(|e| used_as(e, role))?;
     doc.charge(accessor.decoded_bytes(), role)?;
@@ -482,22 +483,25 @@ mod tests {
             ]
         });
         doc_with(&json, &buffer, |doc| {
-            let v = read_floats(doc, 0, "VEC2", "test").unwrap();
+            let v = read_floats(doc, 0, "VEC2", &"test").unwrap();
             assert_eq!(v, vec![0.0, 1.0, 128.0 / 255.0, 64.0 / 255.0]);
             let invalid = |result: Result<Vec<_>, IoError>, words: &str| matches!(&result, Err(IoError::Invalid { message, .. }) if message.contains(words));
-            let past_the_view = read_floats(doc, 1, "VEC2", "test");
+            let past_the_view = read_floats(doc, 1, "VEC2", &"test");
             assert!(
                 invalid(past_the_view, "test"),
                 "third element past the view"
             );
             assert!(
-                invalid(read_floats(doc, 0, "VEC3", "test"), "VEC"),
+                invalid(read_floats(doc, 0, "VEC3", &"test"), "VEC"),
                 "wrong type"
             );
-            assert_eq!(read_uints(doc, 2, "SCALAR", "test").unwrap(), vec![0, 9, 0]);
+            assert_eq!(
+                read_uints(doc, 2, "SCALAR", &"test").unwrap(),
+                vec![0, 9, 0]
+            );
             assert!(
                 matches!(
-                    read_uints(doc, 0, "VEC2", "test"),
+                    read_uints(doc, 0, "VEC2", &"test"),
                     Err(IoError::Invalid { .. })
                 ),
                 "normalized is not an index"
@@ -524,7 +528,7 @@ mod tests {
                     .map(|at| component.decode_u32(&bytes[at..]).unwrap())
                     .collect();
                 doc_with(&json, std::slice::from_ref(&bytes), |doc| {
-                    let read = read_uints(doc, 0, "VEC2", "test").unwrap();
+                    let read = read_uints(doc, 0, "VEC2", &"test").unwrap();
                     assert_eq!(read, expected, "{component:?}, stride {stride}");
                 });
             }

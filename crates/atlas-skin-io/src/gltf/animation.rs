@@ -2,7 +2,7 @@
 
 use super::accessor::read_floats;
 use super::builder::GlbBuilder;
-use super::document::{opt_str, Document};
+use super::document::{opt_str, Document, Location};
 use super::nodes::NodeTree;
 use crate::IoError;
 use atlas_skin_runtime::animation::NO_PARENT_NODE;
@@ -77,7 +77,7 @@ pub(crate) fn read_clips(doc: &Document, warnings: &mut Vec<String>) -> Result<V
         let mut tracks = Vec::new();
         let mut skipped = 0;
         for (c, channel) in channels.iter().enumerate() {
-            let channel_location = format!("{location}.channels[{c}]");
+            let channel_location = Location::child(&location, "channels", c);
             let target = channel
                 .get("target")
                 .ok_or_else(|| doc.error(format!("{channel_location} has no target")))?;
@@ -110,7 +110,7 @@ pub(crate) fn read_clips(doc: &Document, warnings: &mut Vec<String>) -> Result<V
             let track = read_track(
                 doc,
                 sampler,
-                &format!("{location}.samplers[{sampler_index}]"),
+                &Location::child(&location, "samplers", sampler_index),
                 node,
                 property,
             )?;
@@ -141,7 +141,7 @@ pub(crate) fn read_clips(doc: &Document, warnings: &mut Vec<String>) -> Result<V
 fn read_track(
     doc: &Document,
     sampler: &Value,
-    location: &str,
+    location: &Location,
     node: usize,
     property: Property,
 ) -> Result<Track, IoError> {
@@ -156,7 +156,7 @@ fn read_track(
         }
     };
     let input = doc.index(sampler, location, "input")?;
-    let times = read_floats(doc, input, "SCALAR", &format!("{location}.input"))?;
+    let times = read_floats(doc, input, "SCALAR", &Location::field(location, "input"))?;
     if times.iter().any(|t| !t.is_finite()) || times.windows(2).any(|w| w[1] < w[0]) {
         return Err(doc.error(format!(
             "{location}: key times are not finite and ascending"
@@ -168,7 +168,12 @@ fn read_track(
         "VEC3"
     };
     let output = doc.index(sampler, location, "output")?;
-    let values = read_floats(doc, output, value_type, &format!("{location}.output"))?;
+    let values = read_floats(
+        doc,
+        output,
+        value_type,
+        &Location::field(location, "output"),
+    )?;
     let expected = expected_values(property, interpolation, times.len());
     if values.len() != expected {
         return Err(doc.error(format!(

@@ -4,7 +4,7 @@
 //! joint node.
 
 use super::accessor::read_floats;
-use super::document::{opt_str, Document};
+use super::document::{opt_str, Document, Location};
 use super::nodes::NodeTree;
 use crate::IoError;
 use glam::Mat4;
@@ -114,7 +114,7 @@ pub(crate) fn mesh_instances(
         .map(|(_, joints, _)| node_positions(joints))
         .unwrap_or_default();
     for (node, object) in doc.array("nodes")?.iter().enumerate() {
-        let location = format!("nodes[{node}]");
+        let location = Location::item("nodes", node);
         let Some(mesh) = doc.opt_index(object, &location, "mesh")? else {
             continue;
         };

@@ -269,6 +269,20 @@ pub(crate) fn component_bounds(values: &[f32], components: usize) -> (Vec<f32>, 
     (min, max)
 }
 
+/// [`component_bounds`] of `points` (each point's x, y, z as the components), taken from the
+/// points instead of a flattened copy of them: the same `f32::min`/`max` in the same order.
+pub(crate) fn point_bounds(points: &[glam::Vec3]) -> ([f32; 3], [f32; 3]) {
+    let mut min = [f32::INFINITY; 3];
+    let mut max = [f32::NEG_INFINITY; 3];
+    for p in points {
+        for (c, v) in p.to_array().into_iter().enumerate() {
+            min[c] = min[c].min(v);
+            max[c] = max[c].max(v);
+        }
+    }
+    (min, max)
+}
+
 /// The smallest index component type for vertex indices below `vertex_count`.
 fn index_component(vertex_count: usize) -> ComponentType {
     // 65535 is the primitive-restart value of UNSIGNED_SHORT and may not be used.
@@ -282,6 +296,28 @@ fn index_component(vertex_count: usize) -> ComponentType {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The bounds of points are those of their flattened components, signed zeros and
+    /// infinities included.
+    #[test]
+    fn point_bounds_match_the_flattened_bounds() {
+        use glam::Vec3;
+        let points = [
+            Vec3::new(0.0, -0.0, 1.5),
+            Vec3::new(-0.0, 0.0, -2.0),
+            Vec3::new(3.0, f32::INFINITY, -0.0),
+            Vec3::new(f32::NEG_INFINITY, 1e-30, 0.0),
+            Vec3::new(0.25, -1e30, 7.0),
+        ];
+        for n in 0..=points.len() {
+            let flat: Vec<f32> = points[..n].iter().flat_map(|p| p.to_array()).collect();
+            let (min, max) = point_bounds(&points[..n]);
+            let expected = component_bounds(&flat, 3);
+            let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&min), bits(&expected.0), "{n} points");
+            assert_eq!(bits(&max), bits(&expected.1), "{n} points");
+        }
+    }
 
     /// Kept ranges moved within the buffer are the bytes of the copying reference, with
     /// the reference's offsets, for ranges in order with and without gaps (some cases move

@@ -1,6 +1,6 @@
 //! The node hierarchy of a glTF document: parents, local transforms, names.
 
-use super::document::{opt_str, Document};
+use super::document::{opt_str, Document, Location};
 use crate::names::unique_names;
 use crate::IoError;
 use atlas_skin_runtime::forest::find_cycle;
@@ -24,7 +24,7 @@ impl NodeTree {
         let mut parents = vec![None; nodes.len()];
         let mut local = Vec::with_capacity(nodes.len());
         for (index, node) in nodes.iter().enumerate() {
-            let location = format!("nodes[{index}]");
+            let location = Location::item("nodes", index);
             for child in doc.indices(node, &location, "children")? {
                 if child >= nodes.len() {
                     return Err(doc.error(format!(
@@ -76,7 +76,7 @@ impl NodeTree {
 fn local_transform(
     doc: &Document,
     node: &serde_json::Value,
-    location: &str,
+    location: &Location,
 ) -> Result<Trs, IoError> {
     if let Some(m) = doc.opt_floats::<16>(node, location, "matrix")? {
         let (scale, rotation, translation) =

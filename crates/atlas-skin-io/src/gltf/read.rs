@@ -8,7 +8,7 @@ use super::bindings::{
 };
 use super::budget::DecodeBudget;
 use super::container::read_container;
-use super::document::Document;
+use super::document::{Document, Location};
 use super::nodes::{unique_node_names, NodeTree};
 use super::{GltfSource, PrimitiveSource};
 use crate::{Character, Contents, IoError, TriangleMesh};
@@ -148,7 +148,7 @@ fn reject_compressed_geometry(doc: &Document) -> Result<(), IoError> {
 fn find_skin(doc: &Document) -> Result<Option<usize>, IoError> {
     let skin_count = doc.array("skins")?.len();
     for (index, node) in doc.array("nodes")?.iter().enumerate() {
-        let location = format!("nodes[{index}]");
+        let location = Location::item("nodes", index);
         let has_mesh = doc.opt_index(node, &location, "mesh")?.is_some();
         if let (true, Some(skin)) = (has_mesh, doc.opt_index(node, &location, "skin")?) {
             if skin >= skin_count {

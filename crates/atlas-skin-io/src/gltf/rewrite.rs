@@ -2,7 +2,7 @@
 
 use super::animation::append_clips;
 use super::bindings::node_positions;
-use super::builder::{component_bounds, GlbBuilder};
+use super::builder::{component_bounds, point_bounds, GlbBuilder};
 use super::container::view_span_limit;
 use super::new_document::smooth_normals;
 use super::prune::{drop_orphans, References};
@@ -217,11 +217,10 @@ fn set_position_bounds(json: &mut Map<String, Value>, character: &Character, sou
         let Some(positions) = character.mesh.positions.get(primitive.vertices.clone()) else {
             continue;
         };
-        let values: Vec<f32> = positions.iter().flat_map(|p| p.to_array()).collect();
-        if values.is_empty() {
+        if positions.is_empty() {
             continue;
         }
-        let (min, max) = component_bounds(&values, 3);
+        let (min, max) = point_bounds(positions);
         for (key, bound) in [("min", min), ("max", max)] {
             if !same_numbers(accessor.get(key), &bound) {
                 accessor.insert(key.into(), json!(bound));

@@ -192,16 +192,17 @@ fn search_within(
         evaluated: Vec::new(),
     };
     let step = params.angle_step_deg.to_radians();
-    let mut found: Vec<(f64, f64, CutCandidate)> = search
+    // The planes found, as (α, β, index of the plane in `search.evaluated`).
+    let mut found: Vec<(f64, f64, usize)> = search
         .basis
         .coarse_samples(step, params.cone_half_angle_deg.to_radians())
         .into_iter()
-        .filter_map(|(alpha, beta)| search.evaluate(alpha, beta).map(|c| (alpha, beta, c)))
+        .filter_map(|(alpha, beta)| search.evaluate(alpha, beta).map(|i| (alpha, beta, i)))
         .collect();
     let best = found
         .iter()
-        .min_by(|x, y| x.2.perimeter.total_cmp(&y.2.perimeter))
-        .map(|(alpha, beta, c)| (*alpha, *beta, c.perimeter));
+        .min_by(|x, y| search.perimeter(x.2).total_cmp(&search.perimeter(y.2)))
+        .map(|&(alpha, beta, i)| (alpha, beta, search.perimeter(i)));
     if let Some((mut alpha, mut beta, mut perimeter)) = best {
         let basis = search.basis;
         let mut h = step / 2.0;
@@ -213,19 +214,23 @@ fn search_within(
             let better = moves
                 .into_iter()
                 .filter(|&(a, b)| basis.separates(a, b))
-                .filter_map(|(a, b)| search.evaluate(a, b).map(|c| (a, b, c)))
-                .filter(|(_, _, c)| c.perimeter < perimeter)
-                .min_by(|x, y| x.2.perimeter.total_cmp(&y.2.perimeter));
+                .filter_map(|(a, b)| {
+                    search
+                        .evaluate(a, b)
+                        .map(|i| (a, b, search.perimeter(i), i))
+                })
+                .filter(|&(_, _, p, _)| p < perimeter)
+                .min_by(|x, y| x.2.total_cmp(&y.2));
             match better {
-                Some((a, b, c)) => {
-                    (alpha, beta, perimeter) = (a, b, c.perimeter);
-                    found.push((a, b, c));
+                Some((a, b, p, i)) => {
+                    (alpha, beta, perimeter) = (a, b, p);
+                    found.push((a, b, i));
                 }
                 None => h /= 2.0,
             }
         }
     }
-    let mut candidates: Vec<CutCandidate> = found.into_iter().map(|(_, _, c)| c).collect();
+    let mut candidates = search.take_candidates(found.into_iter().map(|(_, _, i)| i));
     candidates.sort_by(|x, y| x.perimeter.total_cmp(&y.perimeter));
     CutSearch {
         candidates,
@@ -345,22 +350,55 @@ struct PlaneSearch<'a> {
 
 impl PlaneSearch<'_> {
     /// The shortest closed section of P(J, n(α, β)) around J that no other bone passes
-    /// through. The pattern search comes back to planes it has evaluated (a move from α to
-    /// α + h tries α + h − h, which is often α to the bit): a plane's outcome depends on
-    /// its normal alone (the point is J), so an evaluated normal's outcome is reused, its
-    /// turned-down sections counted again as a new evaluation would.
-    fn evaluate(&mut self, alpha: f64, beta: f64) -> Option<CutCandidate> {
+    /// through, as the index of its plane in `evaluated`; `None` when there is none. The
+    /// pattern search comes back to planes it has evaluated (a move from α to α + h tries
+    /// α + h − h, which is often α to the bit): a plane's outcome depends on its normal
+    /// alone (the point is J), so an evaluated normal's outcome is reused, its turned-down
+    /// sections counted again as a new evaluation would. The sections stay in `evaluated`
+    /// (not copied per use) until [`Self::take_candidates`].
+    fn evaluate(&mut self, alpha: f64, beta: f64) -> Option<usize> {
         let normal = self.basis.normal(alpha, beta);
         let key = [normal.x.to_bits(), normal.y.to_bits(), normal.z.to_bits()];
-        if let Some((_, best, enclosing)) = self.evaluated.iter().find(|e| e.0 == key) {
+        if let Some(i) = self.evaluated.iter().position(|e| e.0 == key) {
+            let (_, best, enclosing) = &self.evaluated[i];
             self.enclosing_other_bones += enclosing;
-            return best.clone();
+            return best.is_some().then_some(i);
         }
         let before = self.enclosing_other_bones;
         let best = self.shortest_section(normal);
         let enclosing = self.enclosing_other_bones - before;
-        self.evaluated.push((key, best.clone(), enclosing));
-        best
+        let found = best.is_some();
+        self.evaluated.push((key, best, enclosing));
+        found.then_some(self.evaluated.len() - 1)
+    }
+
+    /// F of the section of evaluated plane `i` (one [`Self::evaluate`] gave).
+    fn perimeter(&self, i: usize) -> f64 {
+        self.evaluated[i]
+            .1
+            .as_ref()
+            .map_or(f64::NAN, |c| c.perimeter)
+    }
+
+    /// The sections of the evaluated planes `planes` (indices [`Self::evaluate`] gave), in
+    /// that order: each moved out of `evaluated`, copied only for a plane listed again.
+    fn take_candidates(&mut self, planes: impl Iterator<Item = usize>) -> Vec<CutCandidate> {
+        let mut taken_at: Vec<Option<usize>> = vec![None; self.evaluated.len()];
+        let mut candidates: Vec<CutCandidate> = Vec::new();
+        for i in planes {
+            let candidate = match taken_at[i] {
+                Some(k) => candidates[k].clone(),
+                None => {
+                    taken_at[i] = Some(candidates.len());
+                    self.evaluated[i]
+                        .1
+                        .take()
+                        .expect("an evaluated plane with a section")
+                }
+            };
+            candidates.push(candidate);
+        }
+        candidates
     }
 
     /// [`Self::evaluate`] of the plane through J with unit `normal`, computed.
@@ -420,7 +458,9 @@ mod tests {
 
     /// A plane evaluated again gives what it gave, and counts its turned-down sections
     /// again, as computing it anew does: a bent tube, with and without another bone through
-    /// the joint's sections, the coarse samples and moves of ±h from them, each twice.
+    /// the joint's sections, the coarse samples and moves of ±h from them, each twice. The
+    /// sections taken out at the end are those computed, in the order asked, a plane asked
+    /// for twice given twice.
     #[test]
     fn a_plane_evaluated_again_gives_what_computing_it_gives() {
         use crate::cuts::plane_section::vertex_snap_distances;
@@ -456,21 +496,29 @@ mod tests {
             );
             let h = 5f64.to_radians();
             let samples = reused.basis.coarse_samples(2.0 * h, 30f64.to_radians());
-            let mut found = 0;
+            let (mut asked, mut expected_sections) = (Vec::new(), Vec::new());
             for (alpha, beta) in samples
                 .iter()
                 .flat_map(|&(a, b)| [(a, b), (a + h, b), (a + h - h, b)])
             {
                 for _ in 0..2 {
                     let expected = computed.shortest_section(computed.basis.normal(alpha, beta));
-                    found += usize::from(expected.is_some());
-                    assert_eq!(reused.evaluate(alpha, beta), expected);
+                    let plane = reused.evaluate(alpha, beta);
+                    assert_eq!(plane.is_some(), expected.is_some());
+                    if let (Some(i), Some(expected)) = (plane, expected) {
+                        assert_eq!(reused.evaluated[i].1.as_ref(), Some(&expected));
+                        assert_eq!(reused.perimeter(i), expected.perimeter);
+                        asked.push(i);
+                        expected_sections.push(expected);
+                    }
                     assert_eq!(reused.enclosing_other_bones, computed.enclosing_other_bones);
                 }
             }
-            assert!(found > 0);
+            assert!(!asked.is_empty());
             assert_eq!(computed.enclosing_other_bones > 0, !other_bones.is_empty());
             assert!(reused.evaluated.len() < 3 * samples.len());
+            assert!(asked.len() > reused.evaluated.iter().filter(|e| e.1.is_some()).count());
+            assert_eq!(reused.take_candidates(asked.into_iter()), expected_sections);
         }
     }
 }

@@ -95,6 +95,12 @@ pub struct SectionDomain {
     vertices: Vec<u32>,
     local_positions: Vec<DVec3>,
     local_snap: Vec<f64>,
+    /// Per local vertex: its position minus the point of the last query's plane (p − o of
+    /// [`Plane::signed_distance`]), with that point's bits: the planes of one joint's
+    /// search all pass through the joint, so the differences are taken once for them all
+    /// (the same values, so the same distances).
+    local_offsets: Vec<DVec3>,
+    offsets_origin: Option<[u64; 3]>,
     local_distance: Vec<f64>,
     local_side: Vec<u8>,
     /// Per local edge: its edge of the mesh, its ends (local, in the order of
@@ -207,7 +213,12 @@ fn crossing_point(a: u32, b: u32, da: f64, db: f64) -> CrossingPoint {
 /// 0 (the sign rule above).
 #[inline(always)]
 fn snapped_distance(plane: &Plane, p: DVec3, snap: f64) -> f64 {
-    let signed = plane.signed_distance(p);
+    snapped(plane.signed_distance(p), snap)
+}
+
+/// A vertex's signed distance `signed` snapped to 0 within its snap distance `snap`.
+#[inline(always)]
+fn snapped(signed: f64, snap: f64) -> f64 {
     if signed.abs() < snap {
         0.0
     } else {
@@ -453,6 +464,8 @@ impl SectionDomain {
             faces,
             local_faces,
             local_face_edges,
+            local_offsets: vec![DVec3::ZERO; local_positions.len()],
+            offsets_origin: None,
             local_positions,
             local_snap,
             local_distance: vec![0.0; vertices.len()],
@@ -493,13 +506,21 @@ impl SectionDomain {
 
     /// Computes every vertex's signed distance and side for `plane` and starts a new stamp.
     fn classify(&mut self, plane: &Plane) {
-        for ((d, side), (p, snap)) in self
+        let origin = plane.point.to_array().map(f64::to_bits);
+        if self.offsets_origin != Some(origin) {
+            for (q, p) in self.local_offsets.iter_mut().zip(&self.local_positions) {
+                *q = *p - plane.point;
+            }
+            self.offsets_origin = Some(origin);
+        }
+        for ((d, side), (q, snap)) in self
             .local_distance
             .iter_mut()
             .zip(&mut self.local_side)
-            .zip(self.local_positions.iter().zip(&self.local_snap))
+            .zip(self.local_offsets.iter().zip(&self.local_snap))
         {
-            *d = snapped_distance(plane, *p, *snap);
+            // `snapped_distance` of the vertex: n · (p − o), with p − o kept.
+            *d = snapped(plane.normal.dot(*q), *snap);
             *side = u8::from(*d >= 0.0);
         }
         self.stamp = self.stamp.wrapping_add(1);
@@ -1100,6 +1121,45 @@ mod tests {
                 }
             }
             assert!(compared > 20 && left_out > 0, "{compared} {left_out}");
+        }
+    }
+
+    /// The distances of a query through the point of the query before (its differences
+    /// p − o kept) are those of `snapped_distance`, bit for bit, and its sections those of
+    /// a new domain: planes through one point and through others in turn, points with
+    /// negative zeros among them.
+    #[test]
+    fn kept_differences_give_the_distances_of_the_formula() {
+        let mesh = icosphere(1.0, 3);
+        let topology = Topology::new(&mesh);
+        let snap = vertex_snap_distances(&mesh, &topology, 0.01);
+        let new_domain = || {
+            SectionDomain::new(
+                &mesh,
+                &topology,
+                &snap,
+                all_faces(&mesh),
+                &mut DomainScratch::default(),
+            )
+        };
+        let mut domain = new_domain();
+        let mut random = numbers(5);
+        let points = [
+            DVec3::new(0.1, 0.2, 0.3),
+            DVec3::new(0.0, -0.0, 0.25),
+            DVec3::new(-0.0, 0.0, 0.25),
+        ];
+        for k in 0..30 {
+            let point = points[(k / 3) % points.len()];
+            let normal = DVec3::new(random() - 0.5, random() - 0.5, random() - 0.5).normalize();
+            let plane = Plane { point, normal };
+            let curves = domain.closed_sections(&plane);
+            for (v, &d) in domain.local_distance.iter().enumerate() {
+                let p = domain.local_positions[v];
+                let expected = snapped_distance(&plane, p, domain.local_snap[v]);
+                assert_eq!(d.to_bits(), expected.to_bits(), "query {k}, vertex {v}");
+            }
+            assert_eq!(curves, new_domain().closed_sections(&plane), "query {k}");
         }
     }
 

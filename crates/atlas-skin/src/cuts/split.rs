@@ -13,7 +13,6 @@
 use crate::cuts::plane_section::{CrossingPoint, SectionCurve};
 use crate::mesh::{SurfaceMesh, Topology};
 use crate::tolerance::FLAT;
-use rustc_hash::FxHashMap;
 
 /// The surface with the curves inserted.
 #[derive(Debug, Clone)]
@@ -34,10 +33,12 @@ pub fn split_along_curves(
     curves: &[&SectionCurve],
 ) -> SplitSurface {
     let mut positions = mesh.positions.clone();
-    // Per crossed edge: (t from edges[e][0], new vertex) of every interior crossing.
-    let mut edge_points: FxHashMap<u32, Vec<(f64, u32)>> = FxHashMap::default();
-    // Per face: the chords drawn in it, as vertex pairs of the split surface.
-    let mut face_chords: FxHashMap<u32, Vec<[u32; 2]>> = FxHashMap::default();
+    // Every interior crossing as (crossed edge, t from edges[e][0], new vertex), and every
+    // chord as (face, its vertex pairs on the split surface), in the curves' order; sorted
+    // by edge and face below (stably: each edge's points and each face's chords keep that
+    // order), they are looked up as runs instead of a list per edge and per face.
+    let mut edge_points: Vec<(u32, f64, u32)> = Vec::new();
+    let mut face_chords: Vec<(u32, [u32; 2])> = Vec::new();
     let mut loops = Vec::with_capacity(curves.len());
     for curve in curves {
         let vertices: Vec<u32> = curve
@@ -49,7 +50,7 @@ pub fn split_along_curves(
                     let [a, b] = topology.edges[crossing.edge as usize];
                     positions.push(positions[a as usize].lerp(positions[b as usize], t));
                     let v = positions.len() as u32 - 1;
-                    edge_points.entry(crossing.edge).or_default().push((t, v));
+                    edge_points.push((crossing.edge, t, v));
                     v
                 }
             })
@@ -58,7 +59,7 @@ pub fn split_along_curves(
         for (i, &face) in curve.faces.iter().enumerate() {
             let (a, b) = (vertices[i], vertices[(i + 1) % n]);
             if a != b {
-                face_chords.entry(face).or_default().push([a, b]);
+                face_chords.push((face, [a, b]));
             }
         }
         let mut curve_loop = vertices;
@@ -68,19 +69,30 @@ pub fn split_along_curves(
         }
         loops.push(curve_loop);
     }
+    edge_points.sort_by_key(|&(e, _, _)| e);
+    face_chords.sort_by_key(|&(f, _)| f);
+    let points_on = |e: u32| {
+        let start = edge_points.partition_point(|p| p.0 < e);
+        let end = start + edge_points[start..].partition_point(|p| p.0 == e);
+        &edge_points[start..end]
+    };
 
     // The faces a curve meets: those with a chord or around an edge with a new point (the
     // others are copied without a look-up).
     let mut met = vec![false; mesh.triangle_count()];
-    for &e in edge_points.keys() {
+    for &(e, _, _) in &edge_points {
         for &f in topology.faces_of_edge(e as usize) {
             met[f as usize] = true;
         }
     }
-    for &f in face_chords.keys() {
+    for &(f, _) in &face_chords {
         met[f as usize] = true;
     }
-    let mut triangles = Vec::with_capacity(mesh.triangle_count() + 4 * edge_points.len());
+    let edges_with_points = edge_points.chunk_by(|x, y| x.0 == y.0).count();
+    let mut triangles = Vec::with_capacity(mesh.triangle_count() + 4 * edges_with_points);
+    // The faces' chords in face order, taken run by run as the faces are.
+    let mut chords = face_chords.chunk_by(|x, y| x.0 == y.0).peekable();
+    let mut along: Vec<(f64, u32)> = Vec::new();
     for (f, &t) in mesh.triangles.iter().enumerate() {
         if !met[f] {
             triangles.push(t);
@@ -90,19 +102,24 @@ pub fn split_along_curves(
         let mut boundary = Vec::with_capacity(8);
         for k in 0..3 {
             boundary.push(t[k]);
-            if let Some(points) = edge_points.get(&edges[k]) {
+            let points = points_on(edges[k]);
+            if !points.is_empty() {
                 let forward = topology.edges[edges[k] as usize][0] == t[k];
-                let mut along: Vec<(f64, u32)> = points
-                    .iter()
-                    .map(|&(tau, v)| (if forward { tau } else { 1.0 - tau }, v))
-                    .collect();
+                along.clear();
+                along.extend(
+                    points
+                        .iter()
+                        .map(|&(_, tau, v)| (if forward { tau } else { 1.0 - tau }, v)),
+                );
                 along.sort_by(|x, y| x.0.total_cmp(&y.0));
-                boundary.extend(along.into_iter().map(|(_, v)| v));
+                boundary.extend(along.iter().map(|&(_, v)| v));
             }
         }
         let mut pieces = vec![boundary];
-        for &[a, b] in face_chords.get(&(f as u32)).map_or(&[][..], Vec::as_slice) {
-            cut_piece(&mut pieces, a, b);
+        if let Some(run) = chords.next_if(|run| run[0].0 == f as u32) {
+            for &(_, [a, b]) in run {
+                cut_piece(&mut pieces, a, b);
+            }
         }
         for piece in &pieces {
             fan(piece, &mut positions, &mut triangles);

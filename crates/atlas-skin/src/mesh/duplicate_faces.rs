@@ -16,26 +16,31 @@ use crate::rows::Rows;
 /// earlier one of its group has the same other two vertices. O(V + F) for groups of
 /// bounded size (a vertex's fan).
 pub fn remove_duplicate_faces(mesh: &mut SurfaceMesh) -> usize {
-    let sorted = |t: [u32; 3]| {
-        let mut key = t;
-        key.sort_unstable();
-        key
-    };
-    let triangles = &mesh.triangles;
+    // Each triangle's vertex set as its sorted corners, sorted once (not at every
+    // comparison within its group).
+    let keys: Vec<[u32; 3]> = mesh
+        .triangles
+        .iter()
+        .map(|&t| {
+            let mut key = t;
+            key.sort_unstable();
+            key
+        })
+        .collect();
     let groups = Rows::group_indexed(
         mesh.vertex_count(),
-        triangles.len(),
-        |f| Some(sorted(triangles[f])[0] as usize),
+        keys.len(),
+        |f| Some(keys[f][0] as usize),
         |f| f as u32,
     );
-    let mut copy = vec![false; triangles.len()];
+    let mut copy = vec![false; keys.len()];
     for v in 0..groups.len() {
         let group = groups.row(v);
         for (k, &f) in group.iter().enumerate() {
-            let key = sorted(triangles[f as usize]);
+            let key = keys[f as usize];
             copy[f as usize] = group[..k]
                 .iter()
-                .any(|&g| !copy[g as usize] && sorted(triangles[g as usize]) == key);
+                .any(|&g| !copy[g as usize] && keys[g as usize] == key);
         }
     }
     let before = mesh.triangles.len();
