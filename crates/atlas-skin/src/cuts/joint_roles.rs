@@ -54,8 +54,8 @@
 //!    skin, where r is about 0 and (b) does not apply: a tail tip in a flat sheet that runs
 //!    on past it, feet whose leaves sit in the ankles. A piece of its own past the joint (a
 //!    head modelled apart over its neck, a bag hanging from a belt) is left to the weighting
-//!    of pieces ([`crate::weights::pieces`]), which binds it whole (docs/measurements.md,
-//!    "Leaves whose part runs on past them").
+//!    of pieces ([`crate::weights::pieces`]), which weights it as a whole
+//!    (docs/measurements.md, "Leaves whose part runs on past them").
 //!    Otherwise it is an end site (a fingertip cap reaches about 1.4–1.7 r): no boundary.
 //! 6. Twist and helper joints on a straight bone are chain joints with collinear bones: they
 //!    are cut perpendicular to the bone (the cone search), and the weights stage blends the
@@ -115,7 +115,8 @@ pub struct JointFrame {
     /// other side's knee of a knee. A joint keeps its cut only when its twin gets one
     /// ([`crate::cuts::conflicts`]).
     pub mirror_twin: Option<u32>,
-    /// A leaf whose part runs on past it for at least its bone's length (rule 5 (d)). Its
+    /// A leaf whose part runs on past it, on the piece around its bone, for at least its
+    /// bone's length (rule 5 (d)). Its
     /// soft boundary, where it gets one, is seeded as far as that of a joint with child
     /// bones, and across a face that spans its band there too (step 3 of
     /// [`crate::weights`]): in the skin or in a sheet, its band is as thin as its depth.
@@ -492,9 +493,6 @@ fn leaf_reaches(
     on_piece: Option<(&[u32], u32)>,
 ) -> [bool; 2] {
     let radius = 2.0 * reach;
-    // A bone nearer than p to a vertex within ρ of p lies within 2ρ of p (3ρ leaves room
-    // for rounding): the others need no test.
-    let bones = other_bones(3.0 * radius);
     let mut vertices: Vec<u32> = spheres
         .faces_near(p, radius)
         .into_iter()
@@ -505,6 +503,12 @@ fn leaf_reaches(
     if let Some((pieces, piece)) = on_piece {
         vertices.retain(|&v| pieces[v as usize] == piece);
     }
+    if vertices.is_empty() {
+        return [false; 2];
+    }
+    // A bone nearer than p to a vertex within ρ of p lies within 2ρ of p (3ρ leaves room
+    // for rounding): the others need no test.
+    let bones = other_bones(3.0 * radius);
     let mut found = [false; 2];
     for v in vertices.into_iter().map(|v| mesh.positions[v as usize]) {
         let d = v.distance(p);
