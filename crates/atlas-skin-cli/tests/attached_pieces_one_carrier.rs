@@ -5,7 +5,9 @@
 //!   legs moved (deform max 0.205 of the diagonal against the artist's weights, 3.7 times
 //!   its better baseline's);
 //! - KayKit's Mage, whose wide hat brim reaches out over its hands in the bind pose: the
-//!   brim's ends moved with the wrists (deform max 0.339).
+//!   brim's ends moved with the wrists (deform max 0.339). The hat now holds the head's
+//!   bones (`pieces_around_a_joint.rs`); the rule still moves rows of Mage's other
+//!   attached pieces (27 rows).
 
 mod support;
 
@@ -32,6 +34,6 @@ fn knee_pads_across_the_gap_between_the_knees_move_with_their_own_knee() {
 fn a_hat_brim_over_the_hands_moves_with_the_head() {
     let (off_carrier, deform) = skin_and_deform("bench/kaykit/Mage.glb", "mage");
     assert!(off_carrier > 0, "no row moved onto its carrier");
-    // Measured 0.0063 / 0.190.
+    // Measured 0.0049 / 0.072 (0.0063 / 0.190 before the hat held the head's bones).
     assert!(deform["max"].as_f64().unwrap() < 0.26, "{deform}");
 }

@@ -94,6 +94,19 @@ impl BenchSkin {
             .unwrap_or_else(|| panic!("no joint {name} in the report"))
     }
 
+    /// The pieces and gaps the report lists as weighted as wholes (`pieces.not_decomposed`).
+    pub fn whole_pieces(&self) -> &[serde_json::Value] {
+        self.report["pieces"]["not_decomposed"].as_array().unwrap()
+    }
+
+    /// The piece or gap of `vertices` vertices among [`Self::whole_pieces`].
+    pub fn whole_piece(&self, vertices: u64) -> &serde_json::Value {
+        self.whole_pieces()
+            .iter()
+            .find(|p| p["vertices"] == vertices)
+            .unwrap_or_else(|| panic!("no piece of {vertices} vertices weighted as a whole"))
+    }
+
     /// The deform figures against the artist's weights ([`deform_random`]).
     pub fn deform(&self) -> serde_json::Value {
         deform_random(&self.input, &self.glb)
