@@ -1,6 +1,8 @@
 //! Broken inputs give a clear error: `atlas-skin inspect` and `atlas-skin skin` exit
 //! non-zero, stderr names the file and the problem, nothing panics and `skin` writes no file.
-//! Hostile FBX and rig_info files are made from the corpus's (../shared/data).
+//! Hostile FBX and rig_info files are made from the corpus's (../shared/data). Inputs whose
+//! only fault is in the stored weights are refused by `inspect` and `eval`, which read them,
+//! and skinned by `skin`, which replaces them without reading them.
 
 mod support;
 
@@ -208,30 +210,72 @@ fn file_case(
     }
 }
 
+/// The corpus's ASCII FBX (Skeleton_heaps_ascii.fbx).
+fn heaps() -> String {
+    std::fs::read_to_string(data_file("fbx/Skeleton_heaps_ascii.fbx")).unwrap()
+}
+
+/// The number (from 1) of the first line of `text` that contains `needle`.
+fn line_of(text: &str, needle: &str) -> usize {
+    text.lines().position(|l| l.contains(needle)).unwrap() + 1
+}
+
+/// A case reading `heaps` with `from` replaced by `to` on line `line`, as `file`.
+fn heaps_edit(
+    name: &'static str,
+    heaps: &str,
+    (file, line): (&'static str, usize),
+    (from, to): (&str, &str),
+    problem: &'static str,
+) -> Case {
+    let text: String = heaps
+        .lines()
+        .enumerate()
+        .map(|(i, l)| if i + 1 == line { l.replacen(from, to, 1) } else { l.to_string() } + "\n")
+        .collect();
+    file_case(
+        name,
+        vec![(file, text.into_bytes())],
+        &[],
+        (file, file),
+        problem,
+    )
+}
+
+/// Inputs whose only fault is in the stored weights, each with the bytes of the same file
+/// without the fault: Heaps's ASCII FBX with a cluster weighting a vertex past the mesh's
+/// end, or with a negative weight.
+fn bad_stored_weights() -> Vec<(Case, Vec<u8>)> {
+    let heaps = heaps();
+    let indexes = line_of(&heaps, "Indexes: *50 {");
+    let weights = line_of(&heaps, "Weights: *50 {");
+    let cases = [
+        heaps_edit(
+            "FBX weights on a vertex past the end",
+            &heaps,
+            ("past.fbx", indexes + 1),
+            ("a: 0,", "a: 100000,"),
+            "weights vertex 100000, but the mesh has 445 vertices",
+        ),
+        heaps_edit(
+            "FBX negative weight",
+            &heaps,
+            ("negative.fbx", weights + 1),
+            ("a: 1,", "a: -1,"),
+            "vertex 0 has skin weight -1",
+        ),
+    ];
+    cases
+        .into_iter()
+        .map(|case| (case, heaps.clone().into_bytes()))
+        .collect()
+}
+
 /// The hostile files of the FBX and rig_info readers: truncated, wrong header, huge
 /// declared counts, a node cycle, weights on vertices past the end, non-numbers.
 fn hostile_fbx_and_rig_info() -> Vec<Case> {
     let knight = std::fs::read(data_file("fbx/KayKit_Knight.fbx")).unwrap();
-    let heaps = std::fs::read_to_string(data_file("fbx/Skeleton_heaps_ascii.fbx")).unwrap();
-    let line_of = |needle: &str| heaps.lines().position(|l| l.contains(needle)).unwrap() + 1;
-    // Heaps's ASCII FBX with `from` replaced by `to` on line `line`, read as `file`.
-    let heaps_edit = |name,
-                      (file, line): (&'static str, usize),
-                      (from, to): (&str, &str),
-                      problem| {
-        let text: String = heaps
-            .lines()
-            .enumerate()
-            .map(|(i, l)| if i + 1 == line { l.replacen(from, to, 1) } else { l.to_string() } + "\n")
-            .collect();
-        file_case(
-            name,
-            vec![(file, text.into_bytes())],
-            &[],
-            (file, file),
-            problem,
-        )
-    };
+    let heaps = heaps();
     let rig = std::fs::read_to_string(data_file("rignet-format/498_rig.txt")).unwrap();
     let obj = std::fs::read(data_file("rignet-format/498.obj")).unwrap();
     // 498.obj with the rig_info `text` as its --skeleton `file`.
@@ -252,9 +296,8 @@ fn hostile_fbx_and_rig_info() -> Vec<Case> {
     huge[at..at + 4].copy_from_slice(&0x7fff_ffffu32.to_le_bytes());
     let mut header = knight.clone();
     header[..7].copy_from_slice(b"Kaydarb");
-    let vertices = line_of("Vertices: *1335 {");
-    let indexes = line_of("Indexes: *50 {");
-    let root_connection = line_of("C: \"OO\",551080896,0");
+    let vertices = line_of(&heaps, "Vertices: *1335 {");
+    let root_connection = line_of(&heaps, "C: \"OO\",551080896,0");
     let half = knight[..knight.len() / 2].to_vec();
     vec![
         file_case(
@@ -280,30 +323,28 @@ fn hostile_fbx_and_rig_info() -> Vec<Case> {
         ),
         heaps_edit(
             "ASCII FBX declaring a huge array",
+            &heaps,
             ("count.fbx", vertices),
             ("*1335", "*999999999999"),
             "declares 999999999999 values but holds 1335",
         ),
         heaps_edit(
             "FBX node cycle",
+            &heaps,
             ("cycle.fbx", root_connection),
             ("C: \"OO\",551080896,0", "C: \"OO\",551080896,551069616"),
             "Cyclic node hierarchy",
         ),
         heaps_edit(
-            "FBX weights on a vertex past the end",
-            ("past.fbx", indexes + 1),
-            ("a: 0,", "a: 100000,"),
-            "weights vertex 100000, but the mesh has 445 vertices",
-        ),
-        heaps_edit(
             "FBX array with a word",
+            &heaps,
             ("word.fbx", vertices + 1),
             ("a: -0.559155941009521", "a: abc"),
             "array value \"abc\" is not a number",
         ),
         heaps_edit(
             "FBX with a NaN position",
+            &heaps,
             ("nan.fbx", vertices + 1),
             ("a: -0.559155941009521", "a: nan"),
             "is not finite",
@@ -388,11 +429,13 @@ fn check(case: &Case, output: &Output) -> Result<(), String> {
 
 #[test]
 fn inspect_rejects_broken_inputs_clearly() {
+    let bad_weights = bad_stored_weights().into_iter().map(|(case, _)| case);
     let failures: Vec<String> = cases()
-        .iter()
+        .into_iter()
+        .chain(bad_weights)
         .filter_map(|case| {
             let dir = case_dir("inspect", case.name);
-            check(case, &run(&["inspect"], case, &dir, &[])).err()
+            check(&case, &run(&["inspect"], &case, &dir, &[])).err()
         })
         .collect();
     assert!(failures.is_empty(), "{}", failures.join("\n"));
@@ -419,4 +462,42 @@ fn skin_rejects_broken_inputs_without_writing_output() {
         })
         .collect();
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// `eval` reads the reference's stored weights (here the candidate's too: the same file), so
+/// it refuses bad ones as `inspect` does.
+#[test]
+fn eval_rejects_bad_stored_weights_clearly() {
+    let failures: Vec<String> = bad_stored_weights()
+        .iter()
+        .filter_map(|(case, _)| {
+            let dir = case_dir("eval", case.name);
+            check(case, &run(&["eval"], case, &dir, case.args)).err()
+        })
+        .collect();
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// `skin` replaces the stored weights without reading them: it skins a file whose only
+/// fault is there, and writes the same glb as for the file without the fault.
+#[test]
+fn skin_skins_inputs_whose_only_fault_is_the_stored_weights() {
+    for (bad, sound_bytes) in bad_stored_weights() {
+        let sound = Case {
+            files: vec![(bad.files[0].0, sound_bytes)],
+            ..bad
+        };
+        let [bad_glb, sound_glb] = [("bad", &bad), ("sound", &sound)].map(|(kind, case)| {
+            let dir = case_dir(&format!("skin-{kind}"), case.name);
+            let output = run(&["skin"], case, &dir, &["-o", "{dir}/out.glb"]);
+            assert!(
+                output.status.success(),
+                "{} ({kind}): {}",
+                case.name,
+                String::from_utf8_lossy(&output.stderr)
+            );
+            std::fs::read(dir.join("out.glb")).unwrap()
+        });
+        assert!(bad_glb == sound_glb, "{}: the glbs differ", bad.name);
+    }
 }

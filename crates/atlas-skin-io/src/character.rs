@@ -129,7 +129,7 @@ pub struct LoadOptions {
     pub weights: Option<PathBuf>,
 }
 
-/// What a reader decodes of a glTF input besides its meshes, skeleton and node rig.
+/// What a reader decodes of a glTF or FBX input besides its meshes, skeleton and node rig.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub enum Contents {
     /// Also the stored weights ([`Character::reference_weights`]) and the animations'
@@ -137,9 +137,10 @@ pub enum Contents {
     #[default]
     Everything,
     /// What skinning needs: all but the stored weights, which `atlas-skin skin` replaces
-    /// (their accessors are not decoded, so bad values there do not stop it). The
-    /// animations' keys are read and checked as for [`Contents::Everything`]: the skinned
-    /// file copies them, and a bad key would make it invalid.
+    /// (glTF: their accessors are not decoded; FBX: the clusters' vertices and weights are
+    /// not turned into rows; so bad values there do not stop it). The animations' keys are
+    /// read and checked as for [`Contents::Everything`]: the skinned file copies them, and
+    /// a bad key would make it invalid. FBX bind matrices are read and checked either way.
     ForSkinning,
 }
 

@@ -34,8 +34,9 @@ pub fn load_character(path: &Path, options: &LoadOptions) -> Result<Character, I
     load_character_with(path, options, Contents::Everything)
 }
 
-/// [`load_character`], decoding of a glTF input only `contents` besides its meshes,
-/// skeleton and rig ([`gltf::read_contents`]); other formats are read whole.
+/// [`load_character`], decoding of a glTF or FBX input only `contents` besides its meshes,
+/// skeleton and rig ([`gltf::read_contents`], [`fbx::read_contents`]); other formats are
+/// read whole.
 pub fn load_character_with(
     path: &Path,
     options: &LoadOptions,
@@ -59,7 +60,7 @@ pub fn load_character_with(
         Some(file_mesh) => (compacted_character(path, &file_mesh), file_mesh.positions),
         None => {
             let character = if extension == "fbx" {
-                fbx::read(path)?
+                fbx::read_contents(path, contents)?
             } else {
                 gltf::read_contents(path, contents)?
             };

@@ -93,8 +93,8 @@ impl Input {
         }
     }
 
-    /// [`Input::load`] without what skinning does not use: a glTF input's stored weights
-    /// are not decoded ([`Contents::ForSkinning`]).
+    /// [`Input::load`] without what skinning does not use: a glTF or FBX input's stored
+    /// weights are not decoded ([`Contents::ForSkinning`]).
     fn load_for_skinning(&self) -> Result<Character, IoError> {
         match &self.path {
             Some(path) => {

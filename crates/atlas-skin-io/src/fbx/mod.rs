@@ -10,7 +10,9 @@
 //!   geometric transform), then the unskinned meshes that belong to the character (see
 //!   [`PartBinding`]), in document order; polygons triangulated by ufbx.
 //! - Reference weights: the skin's, rows normalised (a warning says how many did not sum
-//!   to 1); weight 1 on the joint above a rigid part.
+//!   to 1); weight 1 on the joint above a rigid part. Not read for
+//!   [`Contents::ForSkinning`]: ufbx does not gather the clusters' vertices into the skin's
+//!   rows, and the clusters' `Indexes`/`Weights` are neither turned into rows nor checked.
 //! - Units and axes converted to glTF's ([`space::SpaceConversion`]).
 //!
 //! - Materials: each face's base colour (the written glb gets one primitive per material).
@@ -21,7 +23,7 @@ mod ascii_arrays;
 pub mod space;
 
 use crate::names::unique_names;
-use crate::{Character, IoError, Material, MeshPart, PartBinding, TriangleMesh};
+use crate::{Character, Contents, IoError, Material, MeshPart, PartBinding, TriangleMesh};
 use atlas_skin_runtime::{Rig, Skeleton, VertexWeights, NO_PARENT};
 use glam::{DMat4, DVec3};
 use space::SpaceConversion;
@@ -45,8 +47,18 @@ const SUM_TOLERANCE: f64 = 1e-2;
 /// of their mesh, non-finite or negative weights, non-finite positions or bind matrices,
 /// a file without a mesh with triangles.
 pub fn read(path: &Path) -> Result<Character, IoError> {
+    read_contents(path, Contents::Everything)
+}
+
+/// [`read`], with the stored weights only for [`Contents::Everything`]: with
+/// [`Contents::ForSkinning`] the character has no reference weights, and the clusters'
+/// vertices and weights are not checked (a weight on a vertex past the mesh, or a negative
+/// one, does not stop it). The bind pose (the clusters' `TransformLink` and `Transform`)
+/// is read and checked either way.
+pub fn read_contents(path: &Path, contents: Contents) -> Result<Character, IoError> {
     let bytes = crate::text::read_bytes(path)?;
-    let scene = load_scene(path, &bytes)?;
+    let stored_weights = contents == Contents::Everything;
+    let scene = load_scene(path, &bytes, stored_weights)?;
     if scene.metadata.ascii {
         ascii_arrays::check(path, &String::from_utf8_lossy(&bytes))?;
     }
@@ -68,7 +80,7 @@ pub fn read(path: &Path) -> Result<Character, IoError> {
         space: &space,
         joints: &joints,
         mesh: TriangleMesh::default(),
-        rows: Vec::new(),
+        rows: stored_weights.then(Vec::new),
         parts: Vec::new(),
         stored_sums: SumCount::default(),
         materials: Vec::new(),
@@ -99,7 +111,7 @@ pub fn read(path: &Path) -> Result<Character, IoError> {
         stored_sums.warn(&mut warnings);
         character.rig = Some(Rig::from_skeleton(&skeleton));
         character.skeleton = Some(skeleton);
-        character.reference_weights = Some(VertexWeights::from_rows(rows));
+        character.reference_weights = rows.map(VertexWeights::from_rows);
     }
     character.parts = parts;
     if !materials.is_empty() {
@@ -111,8 +123,10 @@ pub fn read(path: &Path) -> Result<Character, IoError> {
     Ok(character)
 }
 
-/// ufbx's scene of `bytes`, forced to be FBX, strict about indices, without animation.
-fn load_scene(path: &Path, bytes: &[u8]) -> Result<ufbx::SceneRoot, IoError> {
+/// ufbx's scene of `bytes`, forced to be FBX, strict about indices, without animation;
+/// the skins' per-vertex weights (`ufbx::SkinDeformer::vertices` and `weights`) only with
+/// `stored_weights`.
+fn load_scene(path: &Path, bytes: &[u8], stored_weights: bool) -> Result<ufbx::SceneRoot, IoError> {
     let limits = ufbx::AllocatorOpts {
         memory_limit: MEMORY_LIMIT,
         ..Default::default()
@@ -123,6 +137,7 @@ fn load_scene(path: &Path, bytes: &[u8]) -> Result<ufbx::SceneRoot, IoError> {
         no_format_from_extension: true,
         ignore_animation: true,
         ignore_embedded: true,
+        skip_skin_vertices: !stored_weights,
         index_error_handling: ufbx::IndexErrorHandling::AbortLoading,
         temp_allocator: ufbx::AllocatorOpts {
             memory_limit: MEMORY_LIMIT,
@@ -337,7 +352,8 @@ struct PartsBuilder<'a> {
     space: &'a SpaceConversion,
     joints: &'a Joints,
     mesh: TriangleMesh,
-    rows: Vec<Vec<(u32, f32)>>,
+    /// One weight row per vertex of `mesh`; `None` when the stored weights are not read.
+    rows: Option<Vec<Vec<(u32, f32)>>>,
     parts: Vec<MeshPart>,
     stored_sums: SumCount,
     materials: Vec<Material>,
@@ -360,7 +376,11 @@ impl PartsBuilder<'_> {
         let name = mesh.element.name.to_string();
         if let Some(skin) = mesh.skin_deformers.first() {
             if let Some(bind) = self.skinned_bind(skin)? {
-                let rows = self.skin_rows(mesh, skin, &name)?;
+                let rows = if self.rows.is_some() {
+                    self.skin_rows(mesh, skin, &name)?
+                } else {
+                    Vec::new()
+                };
                 return self.push(mesh, &name, bind, PartBinding::Skinned, rows);
             }
             warnings.push(format!(
@@ -388,7 +408,7 @@ impl PartsBuilder<'_> {
                         &joint_node.element.name,
                     )?;
                     let bind = self.joints.bind_world[joint as usize] * current.inverse() * world;
-                    let rows = vec![vec![(joint, 1.0)]; mesh.num_vertices];
+                    let rows = self.rigid_rows(joint, mesh);
                     self.push(mesh, &label, bind, PartBinding::Rigid { joint }, rows)?;
                 }
                 None if self.shares_top_node(scene, node) => {
@@ -397,7 +417,7 @@ impl PartsBuilder<'_> {
                         "mesh {label:?} is neither skinned nor under a joint, but in the \
                          skeleton's node tree: made rigid on the root joint"
                     ));
-                    let rows = vec![vec![(0, 1.0)]; mesh.num_vertices];
+                    let rows = self.rigid_rows(0, mesh);
                     self.push(mesh, &label, world, PartBinding::Rigid { joint: 0 }, rows)?;
                 }
                 None => warnings.push(format!(
@@ -417,6 +437,16 @@ impl PartsBuilder<'_> {
         let link = finite_matrix(self.path, &cluster.bind_to_world, &cluster.element.name)?;
         let to_bone = finite_matrix(self.path, &cluster.geometry_to_bone, &cluster.element.name)?;
         Ok(Some(link * to_bone))
+    }
+
+    /// The weight rows of a mesh rigid on `joint`: weight 1 on it (none when the stored
+    /// weights are not read).
+    fn rigid_rows(&self, joint: u32, mesh: &ufbx::Mesh) -> Vec<Vec<(u32, f32)>> {
+        if self.rows.is_some() {
+            vec![vec![(joint, 1.0)]; mesh.num_vertices]
+        } else {
+            Vec::new()
+        }
     }
 
     /// The stored weight rows of a skinned mesh on the skeleton's joints, normalised.
@@ -545,7 +575,8 @@ impl PartsBuilder<'_> {
     }
 
     /// Appends `mesh`'s control points placed by `placement` (then converted to glTF's
-    /// space) and its triangles, with one weight row per control point.
+    /// space) and its triangles, with one weight row per control point (`rows`, padded
+    /// with empty rows; dropped when the stored weights are not read).
     fn push(
         &mut self,
         mesh: &ufbx::Mesh,
@@ -596,8 +627,10 @@ impl PartsBuilder<'_> {
                 self.triangle_materials.push(material);
             }
         }
-        self.rows.extend(rows);
-        self.rows.resize(self.mesh.positions.len(), Vec::new());
+        if let Some(all) = &mut self.rows {
+            all.extend(rows);
+            all.resize(self.mesh.positions.len(), Vec::new());
+        }
         self.parts.push(MeshPart {
             name: name.to_string(),
             vertices: first..self.mesh.positions.len(),
