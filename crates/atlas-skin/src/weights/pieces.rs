@@ -8,7 +8,7 @@
 //! bones a piece *holds* are those that run inside it, for at least half their length
 //! when some do (`held_bones`: a boot holds the foot's bones, a helmet the head's, an
 //! upper-arm shell the upper arm's), else those that poke into it and are the nearest
-//! bones to most of it, else, when no bone enters it, those of the joints around it
+//! bones to most of it, else, when no bone enters it, the bones around it
 //! (`bones_around`: a hat above the head joint); when it holds some, only they are its
 //! candidates,
 //! otherwise the bones of the joints that carry it where it touches the body (**contact**,
@@ -63,9 +63,9 @@
 //! into a piece holding none for half its length is held only when it is the nearest bone
 //! to at least half of the piece's vertices (session 14: a strap across a chest that a
 //! clavicle's bone crosses moved rigidly with the clavicle): deform mean −1.0%, max
-//! −0.9% (7 characters better, 4 worse). A piece that no bone enters holds the bones of
-//! the joints around it (session 16: KayKit Mage's hat was carried by the shoulders its
-//! brim lies on): deform mean −0.9%, max −2.1% (7 characters better, 3 worse).
+//! −0.9% (7 characters better, 4 worse). A piece that no bone enters holds the bones
+//! around it (session 16: KayKit Mage's hat was carried by the shoulders its brim lies
+//! on): deform mean −1.2%, max −2.0% (7 characters better, 4 worse).
 //!
 //! **Contact.** A piece that holds no bone is carried by the body where it touches it.
 //! With d_S(p) as above and s the piece's bounding-box diagonal, its contact zone is
@@ -667,14 +667,17 @@ fn held_bones(
 /// of the piece's vertices ([`bones_around`]; chosen on the benchmark, docs/pieces.md).
 const AROUND_SHARE: f64 = 0.25;
 
-/// The bones of a piece that no bone enters, from the joints around it: those whose joint
-/// lies inside the piece's bounding box and whose bones are the nearest bones of the
-/// skeleton to at least a share σ = [`AROUND_SHARE`] of its vertices (`nearest_to(j)`
-/// counts them). A piece hangs from the joint it is modelled around even where that
-/// joint's bones stay outside it: a hat above the head joint whose bone ends below the
-/// hat, a bag hanging from its joint at a belt, a wing past the root joints of its chain
-/// (the chain's joints in the wing's box all qualify, and the piece bends at their planes).
-/// Without such joints it holds none and is carried by the body it touches.
+/// The bones of a piece that no bone enters, from the joints around it: the bone segments
+/// with an end inside the piece's bounding box whose joint's bones are the nearest bones of
+/// the skeleton to at least a share σ = [`AROUND_SHARE`] of its vertices (`nearest_to(j)`
+/// counts them). A piece hangs from the joints it is modelled around even where their
+/// bones stay outside it: a hat above the head joint whose bone ends below the hat, a bag
+/// hanging from its joint at a belt, a wing past the root joints of its chain (the chain's
+/// bones all qualify, and the piece bends at their planes). A bone that ends inside the box
+/// counts like one that starts there: a bracelet around a wrist holds the forearm's bone,
+/// which ends at the wrist, as well as the hand's, and a belt around the waist the bones on
+/// both sides of the joint inside it, so that neither is rigid to one of them. Without such
+/// bones the piece holds none and is carried by the body it touches.
 fn bones_around(
     surface: &SurfaceMesh,
     vertices: &[u32],
@@ -686,13 +689,12 @@ fn bones_around(
         .map(|&v| surface.positions[v as usize])
         .collect();
     let (lo, hi) = crate::geometry::bounding_box(&positions);
+    let in_box = |q: DVec3| q.cmpge(lo).all() && q.cmple(hi).all();
     let least = AROUND_SHARE * vertices.len() as f64;
     segments
         .iter()
         .copied()
-        .filter(|&(joint, start, _)| {
-            start.cmpge(lo).all() && start.cmple(hi).all() && nearest_to(joint) as f64 >= least
-        })
+        .filter(|&(joint, a, b)| (in_box(a) || in_box(b)) && nearest_to(joint) as f64 >= least)
         .collect()
 }
 
@@ -996,9 +998,10 @@ mod tests {
         // carries it).
         let beyond = (0, DVec3::new(0.0, 1.1, 1.1), DVec3::new(0.0, 2.0, 2.0));
         assert!(held_with(&[beyond, far]).is_empty());
-        // Two joints around it, each the nearest to half of it: both (the piece bends
-        // between them).
-        let below = (2, DVec3::new(0.0, -0.9, -0.9), DVec3::new(0.0, -2.0, -2.0));
+        // Two bones around it, each the nearest to half of it: both (the piece bends
+        // between them), the second one ending inside the box (a forearm's bone ending at
+        // the wrist inside a bracelet).
+        let below = (2, DVec3::new(0.0, -2.0, -2.0), DVec3::new(0.0, -0.9, -0.9));
         assert_eq!(joints_of(&held_with(&[around, far, below])), vec![0, 2]);
         // A joint in a corner of the box, nearest to less than a quarter of the ball, between
         // bones that pass beside it outside the box: nothing.
