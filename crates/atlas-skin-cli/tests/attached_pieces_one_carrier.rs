@@ -7,7 +7,7 @@
 //! - KayKit's Mage, whose wide hat brim reaches out over its hands in the bind pose: the
 //!   brim's ends moved with the wrists (deform max 0.339). The hat now holds the head's
 //!   bones (`pieces_around_a_joint.rs`); the rule still moves rows of Mage's other
-//!   attached pieces (27 rows).
+//!   attached pieces (16 rows).
 
 mod support;
 
