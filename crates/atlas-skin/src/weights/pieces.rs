@@ -648,19 +648,37 @@ fn held_bones(
     if !held.weakly {
         return held.segments;
     }
-    let nearest: Vec<Option<u32>> = vertices
-        .iter()
-        .map(|&v| nearest_joint(surface.positions[v as usize]))
-        .collect();
-    // How many of the piece's vertices have `joint`'s bones as their nearest.
-    let nearest_to = |joint: u32| nearest.iter().filter(|&&n| n == Some(joint)).count();
     if held.segments.is_empty() {
-        return bones_around(surface, vertices, segments, nearest_to);
+        return bones_around(surface, vertices, segments, nearest_joint);
     }
+    let nearest = NearestJoints::of(surface, vertices, nearest_joint);
     held.segments
         .into_iter()
-        .filter(|&(joint, _, _)| 2 * nearest_to(joint) >= nearest.len())
+        .filter(|&(joint, _, _)| 2 * nearest.count(joint) >= vertices.len())
         .collect()
+}
+
+/// The joint of the nearest bone of the skeleton to each vertex of a piece.
+struct NearestJoints(Vec<Option<u32>>);
+
+impl NearestJoints {
+    fn of(
+        surface: &SurfaceMesh,
+        vertices: &[u32],
+        nearest_joint: &(dyn Fn(DVec3) -> Option<u32> + Sync),
+    ) -> Self {
+        Self(
+            vertices
+                .iter()
+                .map(|&v| nearest_joint(surface.positions[v as usize]))
+                .collect(),
+        )
+    }
+
+    /// How many of the piece's vertices have `joint`'s bones as their nearest.
+    fn count(&self, joint: u32) -> usize {
+        self.0.iter().filter(|&&n| n == Some(joint)).count()
+    }
 }
 
 /// A joint around a piece that no bone enters has its bones nearest to at least this share
@@ -669,8 +687,8 @@ const AROUND_SHARE: f64 = 0.25;
 
 /// The bones of a piece that no bone enters, from the joints around it: the bone segments
 /// with an end inside the piece's bounding box whose joint's bones are the nearest bones of
-/// the skeleton to at least a share σ = [`AROUND_SHARE`] of its vertices (`nearest_to(j)`
-/// counts them). A piece hangs from the joints it is modelled around even where their
+/// the skeleton (`nearest_joint`) to at least a share σ = [`AROUND_SHARE`] of its
+/// vertices. A piece hangs from the joints it is modelled around even where their
 /// bones stay outside it: a hat above the head joint whose bone ends below the hat, a bag
 /// hanging from its joint at a belt, a wing past the root joints of its chain (the chain's
 /// bones all qualify, and the piece bends at their planes). A bone that ends inside the box
@@ -682,7 +700,7 @@ fn bones_around(
     surface: &SurfaceMesh,
     vertices: &[u32],
     segments: &[(u32, DVec3, DVec3)],
-    nearest_to: impl Fn(u32) -> usize,
+    nearest_joint: &(dyn Fn(DVec3) -> Option<u32> + Sync),
 ) -> Vec<(u32, DVec3, DVec3)> {
     let positions: Vec<DVec3> = vertices
         .iter()
@@ -690,11 +708,21 @@ fn bones_around(
         .collect();
     let (lo, hi) = crate::geometry::bounding_box(&positions);
     let in_box = |q: DVec3| q.cmpge(lo).all() && q.cmple(hi).all();
-    let least = AROUND_SHARE * vertices.len() as f64;
-    segments
+    let inside: Vec<(u32, DVec3, DVec3)> = segments
         .iter()
         .copied()
-        .filter(|&(joint, a, b)| (in_box(a) || in_box(b)) && nearest_to(joint) as f64 >= least)
+        .filter(|&(_, a, b)| in_box(a) || in_box(b))
+        .collect();
+    // The nearest bones are found only for a piece with bones around it (most pieces that
+    // no bone enters have none: a hair card, a cape).
+    if inside.is_empty() {
+        return inside;
+    }
+    let nearest = NearestJoints::of(surface, vertices, nearest_joint);
+    let least = AROUND_SHARE * vertices.len() as f64;
+    inside
+        .into_iter()
+        .filter(|&(joint, _, _)| nearest.count(joint) as f64 >= least)
         .collect()
 }
 
