@@ -649,7 +649,7 @@ fn held_bones(
         return held.segments;
     }
     if held.segments.is_empty() {
-        return bones_around(surface, vertices, segments, nearest_joint);
+        return bones_around(surface, vertices, held.bounds, segments, nearest_joint);
     }
     let nearest = NearestJoints::of(surface, vertices, nearest_joint);
     held.segments
@@ -686,7 +686,7 @@ impl NearestJoints {
 const AROUND_SHARE: f64 = 0.25;
 
 /// The bones of a piece that no bone enters, from the joints around it: the bone segments
-/// with an end inside the piece's bounding box whose joint's bones are the nearest bones of
+/// with an end inside the piece's bounding box (`lo`, `hi`) whose joint's bones are the nearest bones of
 /// the skeleton (`nearest_joint`) to at least a share σ = [`AROUND_SHARE`] of its
 /// vertices. A piece hangs from the joints it is modelled around even where their
 /// bones stay outside it: a hat above the head joint whose bone ends below the hat, a bag
@@ -699,14 +699,10 @@ const AROUND_SHARE: f64 = 0.25;
 fn bones_around(
     surface: &SurfaceMesh,
     vertices: &[u32],
+    (lo, hi): (DVec3, DVec3),
     segments: &[(u32, DVec3, DVec3)],
     nearest_joint: &(dyn Fn(DVec3) -> Option<u32> + Sync),
 ) -> Vec<(u32, DVec3, DVec3)> {
-    let positions: Vec<DVec3> = vertices
-        .iter()
-        .map(|&v| surface.positions[v as usize])
-        .collect();
-    let (lo, hi) = crate::geometry::bounding_box(&positions);
     let in_box = |q: DVec3| q.cmpge(lo).all() && q.cmple(hi).all();
     let inside: Vec<(u32, DVec3, DVec3)> = segments
         .iter()
@@ -726,11 +722,12 @@ fn bones_around(
         .collect()
 }
 
-/// The segments of [`held_bones_counting`], and whether they are held only weakly (none
-/// has half its points inside).
+/// The segments of [`held_bones_counting`], whether they are held only weakly (none has
+/// half its points inside), and the piece's bounding box (its low and high corners).
 struct Held {
     segments: Vec<(u32, DVec3, DVec3)>,
     weakly: bool,
+    bounds: (DVec3, DVec3),
 }
 
 /// ⌈n/2⌉ of the [`BONE_SAMPLES`]: a segment with this many points inside is held mostly.
@@ -770,6 +767,7 @@ fn held_bones_counting(
             .map(|(segment, _)| segment)
             .collect(),
         weakly,
+        bounds: (lo, hi),
     }
 }
 
