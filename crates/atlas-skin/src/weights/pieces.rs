@@ -197,10 +197,22 @@ pub fn weight_pieces(
                 &segments,
                 &nearest_joint,
             );
-            // A gap's faces do not close around anything: only pieces enclose a root.
-            let around = roots
-                .iter()
-                .find(|&&(_, q)| !unit.gap && faces_inside(&surface.positions, &unit.faces, q));
+            // A gap's faces do not close around anything: only pieces enclose a root. The
+            // winding number is summed only for a root inside the piece's box.
+            let around = (!unit.gap)
+                .then(|| {
+                    let (lo, hi) = crate::geometry::bounding_box(
+                        unit.vertices
+                            .iter()
+                            .map(|&v| &surface.positions[v as usize]),
+                    );
+                    roots.iter().find(|&&(_, q)| {
+                        q.cmpge(lo).all()
+                            && q.cmple(hi).all()
+                            && faces_inside(&surface.positions, &unit.faces, q)
+                    })
+                })
+                .flatten();
             match around {
                 Some(&(root, _)) => bones_from_root(skeleton, root, &held, &segments),
                 None => held,
