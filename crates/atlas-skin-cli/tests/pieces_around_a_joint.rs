@@ -10,9 +10,7 @@ mod support;
 #[test]
 fn a_hat_above_the_head_joint_moves_with_the_head() {
     let skinned = support::BenchSkin::new("kaykit/Mage", "pieces-around-a-joint");
-    let hat = skinned.whole_piece(557);
-    assert_eq!(hat["treatment"], "rigid", "{hat}");
-    assert_eq!(hat["joint"], "head", "{hat}");
+    skinned.assert_rigid(557, "head");
     let deform = skinned.deform();
     // Measured 0.0049 / 0.072.
     assert!(deform["mean"].as_f64().unwrap() < 0.0056, "{deform}");

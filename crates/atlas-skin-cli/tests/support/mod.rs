@@ -107,6 +107,14 @@ impl BenchSkin {
             .unwrap_or_else(|| panic!("no piece of {vertices} vertices weighted as a whole"))
     }
 
+    /// Asserts that the piece of `vertices` vertices ([`Self::whole_piece`]) is rigid to
+    /// the joint named `joint`.
+    pub fn assert_rigid(&self, vertices: u64, joint: &str) {
+        let piece = self.whole_piece(vertices);
+        assert_eq!(piece["treatment"], "rigid", "{piece}");
+        assert_eq!(piece["joint"], joint, "{piece}");
+    }
+
     /// The deform figures against the artist's weights ([`deform_random`]).
     pub fn deform(&self) -> serde_json::Value {
         deform_random(&self.input, &self.glb)

@@ -9,10 +9,13 @@
 //! when some do (`held_bones`: a boot holds the foot's bones, a helmet the head's, an
 //! upper-arm shell the upper arm's), else those that poke into it and are the nearest
 //! bones to most of it, else, when no bone enters it, the bones around it
-//! (`bones_around`: a hat above the head joint). A piece that encloses a root joint of the
-//! skeleton holds the root's bones and, of the others, only those that hang from the root
-//! through bones it holds (`bones_from_root`: a pedestal the feet stand in moves with the
-//! root). When it holds some, only they are its candidates,
+//! (`bones_around`: a hat above the head joint). A piece that encloses a *free* joint (no
+//! boundary of its own, moving skin, bones no piece holds, no sibling at its point: the
+//! root, an end site) holds that joint's bones and keeps, of the others, only those that
+//! run inside it for half their length and do not leave it on the way from that joint
+//! (`with_enclosed_joints`: a pedestal the feet stand in moves with the root, a wand with
+//! its own joint, a head around a cap's joint bends between the two). When it holds some,
+//! only they are its candidates,
 //! otherwise the bones of the joints that carry it where it touches the body (**contact**,
 //! below: a braid hanging from the head over the shoulder, a hair card). With J(p) the
 //! joint of the candidate
@@ -67,11 +70,12 @@
 //! clavicle's bone crosses moved rigidly with the clavicle): deform mean −1.0%, max
 //! −0.9% (7 characters better, 4 worse). A piece that no bone enters holds the bones
 //! around it (session 16: KayKit Mage's hat was carried by the shoulders its brim lies
-//! on): deform mean −1.2%, max −2.0% (7 characters better, 4 worse). A piece around the
-//! root holds the root's bones (session 17: rignet-val/9826's pedestal was bent between
-//! the feet that stand in it, max .454; its artist binds it to the root): deform mean
-//! −6.5%, max −5.0%, on that one character (max .034); no other character has a loose
-//! piece around a root joint.
+//! on): deform mean −1.2%, max −2.0% (7 characters better, 4 worse). A piece around a
+//! free joint holds its bones (session 17): around the root, rignet-val/9826's pedestal
+//! (bent between the feet that stand in it, max .454; its artist binds it to the root):
+//! deform mean −6.5%, max −5.0%, on that one character; around end sites, 12913's wand,
+//! 6789's and 6808's caps: mean −1.7%, max −0.6% more (3 characters better, 1 worse
+//! within 1%).
 //!
 //! **Contact.** A piece that holds no bone is carried by the body where it touches it.
 //! With d_S(p) as above and s the piece's bounding-box diagonal, its contact zone is
@@ -182,43 +186,19 @@ pub fn weight_pieces(
             .min()
             .map(|k| segments[k as usize].0)
     };
-    let bind = skeleton.bind_positions();
-    let roots: Vec<(u32, DVec3)> = (0..skeleton.len())
-        .filter(|&j| skeleton.parent(j).is_none())
-        .map(|j| (j as u32, bind[j].as_dvec3()))
-        .collect();
-    let held: Vec<Vec<(u32, DVec3, DVec3)>> = units
+    let held: Vec<HeldBones> = units
         .par_iter()
         .map(|unit| {
-            let held = held_bones(
+            held_bones(
                 surface,
                 &unit.vertices,
                 &unit.faces,
                 &segments,
                 &nearest_joint,
-            );
-            // A gap's faces do not close around anything: only pieces enclose a root. The
-            // winding number is summed only for a root inside the piece's box.
-            let around = (!unit.gap)
-                .then(|| {
-                    let (lo, hi) = crate::geometry::bounding_box(
-                        unit.vertices
-                            .iter()
-                            .map(|&v| &surface.positions[v as usize]),
-                    );
-                    roots.iter().find(|&&(_, q)| {
-                        q.cmpge(lo).all()
-                            && q.cmple(hi).all()
-                            && faces_inside(&surface.positions, &unit.faces, q)
-                    })
-                })
-                .flatten();
-            match around {
-                Some(&(root, _)) => bones_from_root(skeleton, root, &held, &segments),
-                None => held,
-            }
+            )
         })
         .collect();
+    let held = with_enclosed_joints(decomposition, skeleton, &units, held, &segments);
     let planes = boundary_planes(decomposition, overlaps);
     // Pieces that hold bones first, on the body surface; then the pieces that hold none,
     // on the body surface and the pieces of the first pass (a hat sits on a head piece).
@@ -674,19 +654,30 @@ fn held_bones(
     faces: &[[u32; 3]],
     segments: &[(u32, DVec3, DVec3)],
     nearest_joint: &(dyn Fn(DVec3) -> Option<u32> + Sync),
-) -> Vec<(u32, DVec3, DVec3)> {
+) -> HeldBones {
     let held = held_bones_counting(surface, vertices, faces, segments, samples_inside);
-    if !held.weakly {
-        return held.segments;
+    let segments = if !held.weakly {
+        held.segments
+    } else if held.segments.is_empty() {
+        bones_around(surface, vertices, held.bounds, segments, nearest_joint)
+    } else {
+        let nearest = NearestJoints::of(surface, vertices, nearest_joint);
+        held.segments
+            .into_iter()
+            .filter(|&(joint, _, _)| 2 * nearest.count(joint) >= vertices.len())
+            .collect()
+    };
+    HeldBones {
+        segments,
+        mostly: !held.weakly,
     }
-    if held.segments.is_empty() {
-        return bones_around(surface, vertices, held.bounds, segments, nearest_joint);
-    }
-    let nearest = NearestJoints::of(surface, vertices, nearest_joint);
-    held.segments
-        .into_iter()
-        .filter(|&(joint, _, _)| 2 * nearest.count(joint) >= vertices.len())
-        .collect()
+}
+
+/// The bones a piece holds ([`held_bones`]), and whether they run inside it for at least
+/// half their length (else they only poke into it, or lie around it).
+struct HeldBones {
+    segments: Vec<(u32, DVec3, DVec3)>,
+    mostly: bool,
 }
 
 /// The joint of the nearest bone of the skeleton to each vertex of a piece.
@@ -753,33 +744,120 @@ fn bones_around(
         .collect()
 }
 
-/// The bones of a piece that encloses the root joint `root` of the skeleton (the joint every
-/// other one moves with): the root's own bones, and those of the `held` bones whose joint
-/// hangs from the root through joints whose bones the piece holds too. A base or a
-/// pedestal that the character stands in moves with the root, not with the feet whose
-/// bones end inside it (their chains leave the piece and come back into it); a closed pair
-/// of shorts around a hips root still bends at the thighs, whose bones start at the root.
-fn bones_from_root(
+/// Two sibling joints closer than this share of the skeleton's diagonal sit at one point
+/// (bind matrices are stored in single precision; inverted, they place such twins a few
+/// millionths apart).
+const SAME_POINT: f64 = 1e-5;
+
+/// The bones of the pieces that enclose a joint left free (module documentation): a joint
+/// with no boundary of its own (the root, an end site, a joint whose surface was not found),
+/// that moves skin (not a helper), whose bones no piece holds and that has no sibling at
+/// its point (two eye-lid joints at the centre of one eye: the geometry cannot tell which
+/// half is whose). A piece (not a gap: a gap's faces close around nothing) whose faces
+/// enclose such joints (winding number |w| > ½ at the joint) holds their bones, with those
+/// of its held bones ([`held_bones`]) that [`bones_kept_beside`] keeps.
+fn with_enclosed_joints(
+    decomposition: &Decomposition,
     skeleton: &Skeleton,
-    root: u32,
-    held: &[(u32, DVec3, DVec3)],
+    units: &[Unit],
+    held: Vec<HeldBones>,
+    segments: &[(u32, DVec3, DVec3)],
+) -> Vec<Vec<(u32, DVec3, DVec3)>> {
+    let bind: Vec<DVec3> = skeleton
+        .bind_positions()
+        .iter()
+        .map(|p| p.as_dvec3())
+        .collect();
+    let mut taken = vec![false; skeleton.len()];
+    for segment in held.iter().flat_map(|h| &h.segments) {
+        taken[segment.0 as usize] = true;
+    }
+    let (lo, hi) = crate::geometry::bounding_box(&bind);
+    let same_point = SAME_POINT * (hi - lo).length();
+    let twin = |j: usize| {
+        (0..skeleton.len()).any(|k| {
+            k != j
+                && skeleton.parent(k) == skeleton.parent(j)
+                && bind[k].distance(bind[j]) <= same_point
+        })
+    };
+    let free: Vec<u32> = (0..skeleton.len())
+        .filter(|&j| {
+            let decision = &decomposition.joints[j];
+            !taken[j] && decision.boundary.is_none() && decision.owns_skin && !twin(j)
+        })
+        .map(|j| j as u32)
+        .collect();
+    let positions = &decomposition.surface.positions;
+    units
+        .par_iter()
+        .zip(held)
+        .map(|(unit, held)| {
+            if unit.gap || free.is_empty() {
+                return held.segments;
+            }
+            let (lo, hi) = crate::geometry::bounding_box(
+                unit.vertices.iter().map(|&v| &positions[v as usize]),
+            );
+            let enclosed: Vec<u32> = free
+                .iter()
+                .copied()
+                .filter(|&j| {
+                    let q = bind[j as usize];
+                    q.cmpge(lo).all()
+                        && q.cmple(hi).all()
+                        && faces_inside(positions, &unit.faces, q)
+                })
+                .collect();
+            if enclosed.is_empty() {
+                held.segments
+            } else {
+                bones_kept_beside(skeleton, &enclosed, &held, segments)
+            }
+        })
+        .collect()
+}
+
+/// The bones of a piece that encloses the free joints `enclosed` ([`with_enclosed_joints`]):
+/// theirs, and of the bones it `held`, only those that run inside it for half their length
+/// (`held.mostly`; a bone that only pokes into it yields to a joint inside it) and do not
+/// hang from an enclosed joint through a joint whose bones it does not hold (a chain that
+/// leaves the piece and comes back into it). A pedestal that encloses the root joint, with
+/// the feet standing in it, moves with the root, not with the feet whose bones end inside it;
+/// a wand around its own joint moves with that joint, not with the wrist whose bone runs
+/// into its handle; a head piece around the joint of a cap at the back of the head bends
+/// between the head, whose bone runs inside it, and the cap; a closed pair of shorts around
+/// a hips root still bends at the thighs, whose bones start at the root.
+fn bones_kept_beside(
+    skeleton: &Skeleton,
+    enclosed: &[u32],
+    held: &HeldBones,
     segments: &[(u32, DVec3, DVec3)],
 ) -> Vec<(u32, DVec3, DVec3)> {
-    let holds = |joint: u32| joint == root || held.iter().any(|s| s.0 == joint);
-    let from_root = |joint: u32| {
+    let holds = |joint: usize| {
+        enclosed.contains(&(joint as u32)) || held.segments.iter().any(|s| s.0 as usize == joint)
+    };
+    // Whether the chain from `joint` up to the enclosed joint above it (if any) stays in the
+    // piece: every joint on the way holds bones in it.
+    let through_the_piece = |joint: u32| {
         let mut k = joint as usize;
-        while k != root as usize {
-            match skeleton.parent(k) {
-                Some(parent) if holds(parent as u32) => k = parent,
-                _ => return false,
+        let mut inside = true;
+        while let Some(parent) = skeleton.parent(k) {
+            if enclosed.contains(&(parent as u32)) {
+                return inside;
             }
+            inside &= holds(parent);
+            k = parent;
         }
         true
     };
     segments
         .iter()
         .copied()
-        .filter(|s| s.0 == root || (held.contains(s) && from_root(s.0)))
+        .filter(|s| {
+            enclosed.contains(&s.0)
+                || (held.mostly && held.segments.contains(s) && through_the_piece(s.0))
+        })
         .collect()
 }
 
@@ -1040,7 +1118,7 @@ mod tests {
         let held = held_bones(&ball, &vertices, &ball.triangles, &segments, &|p| {
             nearest_bone(&segments, p)
         });
-        assert_eq!(joints_of(&held), vec![0]);
+        assert_eq!(joints_of(&held.segments), vec![0]);
         // Bone 3 starts inside and runs out: an eighth of it is inside. Held only when no
         // bone is held for half its length and its bones are the nearest to at least half
         // of the piece.
@@ -1048,12 +1126,12 @@ mod tests {
         with_tip.push((3, DVec3::new(0.0, 0.9, 0.0), DVec3::new(0.0, 1.9, 0.0)));
         let nearest_tip = |p: DVec3| nearest_bone(&with_tip, p);
         let held = held_bones(&ball, &vertices, &ball.triangles, &with_tip, &nearest_tip);
-        assert_eq!(joints_of(&held), vec![0]);
+        assert_eq!(joints_of(&held.segments), vec![0]);
         let tip_only = [with_tip[2], with_tip[3]];
         let held = held_bones(&ball, &vertices, &ball.triangles, &tip_only, &|p| {
             nearest_bone(&tip_only, p)
         });
-        assert_eq!(joints_of(&held), vec![3]);
+        assert_eq!(joints_of(&held.segments), vec![3]);
         let cap = faces_above(&ball, 0.8);
         assert!(!cap.is_empty());
         let mut cap_vertices: Vec<u32> = cap.iter().flatten().copied().collect();
@@ -1063,6 +1141,7 @@ mod tests {
             held_bones(&ball, &cap_vertices, &cap, &segments, &|p| nearest_bone(
                 &segments, p
             ))
+            .segments
             .is_empty()
         );
     }
@@ -1077,6 +1156,7 @@ mod tests {
             held_bones(&ball, &vertices, &ball.triangles, segments, &|p| {
                 nearest_bone(segments, p)
             })
+            .segments
         };
         // Joint 0 sits outside the ball but inside its box, its bone running away from it:
         // the nearest bone to the whole ball.
@@ -1107,34 +1187,47 @@ mod tests {
     }
 
     #[test]
-    fn a_piece_around_the_root_holds_the_bones_that_hang_from_it_through_the_piece() {
-        // Root 0 with a spine 1 and a leg 2 → 3 → 4 (thigh, shin, foot), each joint's bone
-        // to its child, the foot's to a toe.
+    fn a_piece_around_a_free_joint_keeps_the_bones_that_do_not_leave_it() {
+        // Root 0 with a spine 1 and a leg 2 → 3 → 4 (thigh, shin, foot), and an arm from the
+        // spine: a wrist 5 and a wand's joint 6. Each joint's bone runs to its child, a
+        // leaf's on past it.
         let p = |x: f64, y: f64| DVec3::new(x, y, 0.0);
         let skeleton = Skeleton {
-            names: (0..5).map(|k| format!("joint{k}")).collect(),
-            parents: vec![NO_PARENT, 0, 0, 2, 3],
-            tails: vec![None; 5],
-            inverse_bind: vec![glam::Mat4::IDENTITY; 5],
+            names: (0..7).map(|k| format!("joint{k}")).collect(),
+            parents: vec![NO_PARENT, 0, 0, 2, 3, 1, 5],
+            tails: vec![None; 7],
+            inverse_bind: vec![glam::Mat4::IDENTITY; 7],
         };
         let segments = [
             (0, p(0.0, 1.0), p(0.0, 2.0)),
             (0, p(0.0, 1.0), p(0.2, 0.9)),
+            (1, p(0.0, 2.0), p(0.6, 2.0)),
             (2, p(0.2, 0.9), p(0.2, 0.5)),
             (3, p(0.2, 0.5), p(0.2, 0.1)),
             (4, p(0.2, 0.1), p(0.3, 0.0)),
+            (5, p(0.6, 2.0), p(0.8, 2.0)),
+            (6, p(0.8, 2.0), p(0.9, 2.0)),
         ];
-        let from_root = |held: &[(u32, DVec3, DVec3)]| {
-            joints_of(&bones_from_root(&skeleton, 0, held, &segments))
+        let kept = |enclosed: &[u32], held: &[(u32, DVec3, DVec3)], mostly: bool| {
+            let held = HeldBones {
+                segments: held.to_vec(),
+                mostly,
+            };
+            joints_of(&bones_kept_beside(&skeleton, enclosed, &held, &segments))
         };
-        // A pedestal that the foot stands in: the foot's chain leaves it at the root and
-        // comes back; it moves with the root alone.
-        assert_eq!(from_root(&[segments[4]]), vec![0, 0]);
+        // A pedestal around the root that the foot stands in: the foot's chain leaves it at
+        // the root and comes back; it moves with the root alone.
+        assert_eq!(kept(&[0], &[segments[5]], true), vec![0, 0]);
         // Shorts around the root holding the thigh: the thigh hangs from the root.
-        assert_eq!(from_root(&[segments[2]]), vec![0, 0, 2]);
+        assert_eq!(kept(&[0], &[segments[3]], true), vec![0, 0, 2]);
         // A long skirt holding the thigh and the shin, but not the shin alone.
-        assert_eq!(from_root(&segments[2..4]), vec![0, 0, 2, 3]);
-        assert_eq!(from_root(&[segments[3]]), vec![0, 0]);
+        assert_eq!(kept(&[0], &segments[3..5], true), vec![0, 0, 2, 3]);
+        assert_eq!(kept(&[0], &[segments[4]], true), vec![0, 0]);
+        // A wand around its joint that the wrist's bone only pokes into: the wand's joint.
+        assert_eq!(kept(&[6], &[segments[6]], false), vec![6]);
+        // A piece around the wand's joint that the wrist's bone runs through for half its
+        // length (a head around a cap's joint): it bends between the two.
+        assert_eq!(kept(&[6], &[segments[6]], true), vec![5, 6]);
     }
 
     fn joints_of(segments: &[(u32, DVec3, DVec3)]) -> Vec<u32> {
@@ -1154,14 +1247,14 @@ mod tests {
         let held = held_bones(&strap, &vertices, &strap.triangles, &segments, &|p| {
             nearest_bone(&segments, p)
         });
-        assert!(held.is_empty(), "{held:?}");
+        assert!(held.segments.is_empty(), "{:?}", held.segments);
         // With the other bone far away, the bone that pokes in is the nearest to all of it.
         let far = (1, DVec3::new(0.0, 5.0, 0.0), DVec3::new(4.0, 5.0, 0.0));
         let segments = [across, far];
         let held = held_bones(&strap, &vertices, &strap.triangles, &segments, &|p| {
             nearest_bone(&segments, p)
         });
-        assert_eq!(joints_of(&held), vec![0]);
+        assert_eq!(joints_of(&held.segments), vec![0]);
     }
 
     /// Every point tested: the reference for [`samples_inside`].
