@@ -14,11 +14,7 @@ fn a_pedestal_around_the_root_moves_with_the_root() {
     let skinned = support::BenchSkin::new("rignet-val/9826", "pieces-around-a-free-joint");
     let root = "rstr0156_00_fi";
     skinned.assert_rigid(108, root);
-    let on_it: Vec<_> = skinned
-        .whole_pieces()
-        .iter()
-        .filter(|p| p["vertices"] == 13)
-        .collect();
+    let on_it = skinned.whole_pieces_of(13);
     assert_eq!(on_it.len(), 2);
     for piece in on_it {
         assert_eq!(piece["joint"], root, "{piece}");
@@ -57,4 +53,19 @@ fn a_head_around_a_cap_joint_bends_between_them() {
     // Measured 0.0068 / 0.090.
     assert!(deform["mean"].as_f64().unwrap() < 0.0078, "{deform}");
     assert!(deform["max"].as_f64().unwrap() < 0.105, "{deform}");
+}
+
+/// rignet-val/6243's eye lids (242 vertices each) enclose two lid joints at one point, the
+/// upper and the lower lid's, which its artist splits them between: the geometry cannot tell
+/// which half is whose, so neither joint is free and the lids stay rigid to the head (made
+/// rigid to the lower lid, the character's mean rose by 5.7%).
+#[test]
+fn eye_lids_around_twin_joints_stay_with_the_head() {
+    let skinned = support::BenchSkin::new("rignet-val/6243", "pieces-around-a-free-joint");
+    let lids = skinned.whole_pieces_of(242);
+    assert_eq!(lids.len(), 2);
+    for lid in lids {
+        assert_eq!(lid["treatment"], "rigid", "{lid}");
+        assert_eq!(lid["joint"], "head_1", "{lid}");
+    }
 }

@@ -99,11 +99,19 @@ impl BenchSkin {
         self.report["pieces"]["not_decomposed"].as_array().unwrap()
     }
 
-    /// The piece or gap of `vertices` vertices among [`Self::whole_pieces`].
-    pub fn whole_piece(&self, vertices: u64) -> &serde_json::Value {
+    /// The pieces and gaps of `vertices` vertices among [`Self::whole_pieces`].
+    pub fn whole_pieces_of(&self, vertices: u64) -> Vec<&serde_json::Value> {
         self.whole_pieces()
             .iter()
-            .find(|p| p["vertices"] == vertices)
+            .filter(|p| p["vertices"] == vertices)
+            .collect()
+    }
+
+    /// The first piece or gap of `vertices` vertices among [`Self::whole_pieces`].
+    pub fn whole_piece(&self, vertices: u64) -> &serde_json::Value {
+        self.whole_pieces_of(vertices)
+            .first()
+            .copied()
             .unwrap_or_else(|| panic!("no piece of {vertices} vertices weighted as a whole"))
     }
 

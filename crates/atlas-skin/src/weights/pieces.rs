@@ -110,6 +110,7 @@ use crate::mesh::{FaceSpheres, SurfaceMesh};
 use crate::overlap::Overlaps;
 use crate::skeleton::bone_tree::BoneTree;
 use crate::skeleton::bones::{bone_segments, nearest_bone_with_distance, NearestBone};
+use crate::skeleton::nearest_point::PointGrid;
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -774,12 +775,12 @@ fn with_enclosed_joints(
     }
     let (lo, hi) = crate::geometry::bounding_box(&bind);
     let same_point = SAME_POINT * (hi - lo).length();
+    let joints = OnceLock::new();
     let twin = |j: usize| {
-        (0..skeleton.len()).any(|k| {
-            k != j
-                && skeleton.parent(k) == skeleton.parent(j)
-                && bind[k].distance(bind[j]) <= same_point
-        })
+        let grid = joints.get_or_init(|| PointGrid::new(&bind));
+        grid.within(bind[j], same_point)
+            .into_iter()
+            .any(|k| k as usize != j && skeleton.parent(k as usize) == skeleton.parent(j))
     };
     let free: Vec<u32> = (0..skeleton.len())
         .filter(|&j| {
