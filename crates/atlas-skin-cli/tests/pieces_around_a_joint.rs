@@ -11,8 +11,6 @@ mod support;
 fn a_hat_above_the_head_joint_moves_with_the_head() {
     let skinned = support::BenchSkin::new("kaykit/Mage", "pieces-around-a-joint");
     skinned.assert_rigid(557, "head");
-    let deform = skinned.deform();
     // Measured 0.0049 / 0.072.
-    assert!(deform["mean"].as_f64().unwrap() < 0.0056, "{deform}");
-    assert!(deform["max"].as_f64().unwrap() < 0.100, "{deform}");
+    skinned.assert_deform_below(0.0056, 0.100);
 }

@@ -115,12 +115,26 @@ impl BenchSkin {
             .unwrap_or_else(|| panic!("no piece of {vertices} vertices weighted as a whole"))
     }
 
-    /// Asserts that the piece of `vertices` vertices ([`Self::whole_piece`]) is rigid to
-    /// the joint named `joint`.
-    pub fn assert_rigid(&self, vertices: u64, joint: &str) {
-        let piece = self.whole_piece(vertices);
-        assert_eq!(piece["treatment"], "rigid", "{piece}");
-        assert_eq!(piece["joint"], joint, "{piece}");
+    /// Asserts that every piece of `vertices` vertices ([`Self::whole_pieces_of`], at least
+    /// one) is rigid to the joint named `joint`; returns how many there are.
+    pub fn assert_rigid(&self, vertices: u64, joint: &str) -> usize {
+        let pieces = self.whole_pieces_of(vertices);
+        assert!(
+            !pieces.is_empty(),
+            "no piece of {vertices} vertices weighted as a whole"
+        );
+        for piece in &pieces {
+            assert_eq!(piece["treatment"], "rigid", "{piece}");
+            assert_eq!(piece["joint"], joint, "{piece}");
+        }
+        pieces.len()
+    }
+
+    /// Asserts that the deform figures ([`Self::deform`]) are below `mean` and `max`.
+    pub fn assert_deform_below(&self, mean: f64, max: f64) {
+        let deform = self.deform();
+        assert!(deform["mean"].as_f64().unwrap() < mean, "{deform}");
+        assert!(deform["max"].as_f64().unwrap() < max, "{deform}");
     }
 
     /// The deform figures against the artist's weights ([`deform_random`]).

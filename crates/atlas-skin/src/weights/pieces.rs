@@ -671,14 +671,17 @@ fn held_bones(
     HeldBones {
         segments,
         mostly: !held.weakly,
+        bounds: held.bounds,
     }
 }
 
-/// The bones a piece holds ([`held_bones`]), and whether they run inside it for at least
-/// half their length (else they only poke into it, or lie around it).
+/// The bones a piece holds ([`held_bones`]), whether they run inside it for at least half
+/// their length (else they only poke into it, or lie around it), and the piece's bounding
+/// box (its low and high corners).
 struct HeldBones {
     segments: Vec<(u32, DVec3, DVec3)>,
     mostly: bool,
+    bounds: (DVec3, DVec3),
 }
 
 /// The joint of the nearest bone of the skeleton to each vertex of a piece.
@@ -797,9 +800,7 @@ fn with_enclosed_joints(
             if unit.gap || free.is_empty() {
                 return held.segments;
             }
-            let (lo, hi) = crate::geometry::bounding_box(
-                unit.vertices.iter().map(|&v| &positions[v as usize]),
-            );
+            let (lo, hi) = held.bounds;
             let enclosed: Vec<u32> = free
                 .iter()
                 .copied()
@@ -1213,6 +1214,7 @@ mod tests {
             let held = HeldBones {
                 segments: held.to_vec(),
                 mostly,
+                bounds: (DVec3::splat(-1.0), DVec3::splat(3.0)),
             };
             joints_of(&bones_kept_beside(&skeleton, enclosed, &held, &segments))
         };
