@@ -74,7 +74,7 @@
 //! free joint holds its bones (session 17): around the root, rignet-val/9826's pedestal
 //! (bent between the feet that stand in it, max .454; its artist binds it to the root):
 //! deform mean −6.5%, max −5.0%, on that one character; around end sites, 12913's wand,
-//! 6789's and 6808's caps: mean −1.7%, max −0.6% more (3 characters better, 1 worse
+//! 6789's and 6808's heads around a cap's joint: mean −1.7%, max −0.6% more (3 better, 1 worse
 //! within 1%).
 //!
 //! **Contact.** A piece that holds no bone is carried by the body where it touches it.
