@@ -11,7 +11,7 @@ mod support;
 /// diagonal against the artist's weights, who binds all three to the root).
 #[test]
 fn a_pedestal_around_the_root_moves_with_the_root() {
-    let skinned = support::BenchSkin::new("rignet-val/9826", "pieces-around-a-free-joint");
+    let skinned = support::BenchSkin::new("rignet-val/9826", "pieces-around-a-free-joint-pedestal");
     let root = "rstr0156_00_fi";
     skinned.assert_rigid(108, root);
     assert_eq!(
@@ -28,7 +28,7 @@ fn a_pedestal_around_the_root_moves_with_the_root() {
 /// mean 0.0143); its artist binds it to the wand's joint.
 #[test]
 fn a_wand_around_its_joint_moves_with_that_joint() {
-    let skinned = support::BenchSkin::new("rignet-val/12913", "pieces-around-a-free-joint");
+    let skinned = support::BenchSkin::new("rignet-val/12913", "pieces-around-a-free-joint-wand");
     for vertices in [30, 21, 16] {
         skinned.assert_rigid(vertices, "morton_magic_wand_root");
     }
@@ -42,7 +42,7 @@ fn a_wand_around_its_joint_moves_with_that_joint() {
 /// own piece (33 vertices) moves with the cap.
 #[test]
 fn a_head_around_a_cap_joint_bends_between_them() {
-    let skinned = support::BenchSkin::new("rignet-val/6789", "pieces-around-a-free-joint");
+    let skinned = support::BenchSkin::new("rignet-val/6789", "pieces-around-a-free-joint-cap");
     let head = skinned.whole_piece(218);
     assert_eq!(head["treatment"], "joints", "{head}");
     skinned.assert_rigid(33, "cap");
@@ -56,6 +56,6 @@ fn a_head_around_a_cap_joint_bends_between_them() {
 /// rigid to the lower lid, the character's mean rose by 5.7%).
 #[test]
 fn eye_lids_around_twin_joints_stay_with_the_head() {
-    let skinned = support::BenchSkin::new("rignet-val/6243", "pieces-around-a-free-joint");
+    let skinned = support::BenchSkin::new("rignet-val/6243", "pieces-around-a-free-joint-eye-lids");
     assert_eq!(skinned.assert_rigid(242, "head_1"), 2, "the two lids");
 }
