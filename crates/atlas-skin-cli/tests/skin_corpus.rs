@@ -108,6 +108,7 @@ fn skin_runs_on_every_corpus_model_and_writes_valid_bound_skins() {
             "unreachable_vertices",
             "fallback_weighted_vertices",
             "leaf_patches",
+            "twins_given_a_share",
             "duplicate_faces",
         ] {
             assert!(

@@ -21,7 +21,7 @@ use crate::overlap::{compute_overlaps, OverlapError, OverlapParams, Overlaps};
 use crate::rows::{Rows, PAR_CHUNK};
 use crate::skeleton::bones::{bone_segments, capped_extensions, nearest_bone, EXTENSION_JOINTS};
 use crate::skeleton::hierarchy::infer_hierarchy;
-use crate::skeleton::placement::{check_placement, decomposition_warnings, PlacementError};
+use crate::skeleton::placement::{check_placement, decomposition_warnings, listed, PlacementError};
 use crate::weights::blend::Blend;
 use crate::weights::{compute_weights, SurfaceWeights, WeightCounts, WeightsError};
 use atlas_skin_runtime::{RuntimeError, Skeleton, VertexWeights};
@@ -253,6 +253,20 @@ pub fn skin(
     let done = run(Stage::Weights);
     let (surface_weights, weight_counts) =
         compute_weights(&decomposition, &skeleton, &overlaps, params.blend)?;
+    if !weight_counts.twins_given_a_share.is_empty() {
+        warnings.push(format!(
+            "{} joint(s) sit at the point of a joint that has weight and got none of their \
+             own: each shares its twins' weight equally (nothing in the geometry tells them \
+             apart): {}",
+            weight_counts.twins_given_a_share.len(),
+            listed(
+                weight_counts
+                    .twins_given_a_share
+                    .iter()
+                    .map(|&j| skeleton.names[j as usize].clone())
+            )
+        ));
+    }
     let weights = unweld_weights(
         &surface_weights,
         &welded.welded_of_stored,

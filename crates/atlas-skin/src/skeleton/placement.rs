@@ -171,8 +171,8 @@ pub fn decomposition_warnings(decomposition: &Decomposition, forbidden: &[String
     }
     if joints.len() >= 2 && decomposition.boundaries.is_empty() {
         warnings.push(format!(
-            "no joint got a boundary: the whole mesh is {} region(s) bound rigidly to their \
-             joints (see each joint's reason in the decomposition)",
+            "no joint got a boundary: the whole mesh is {} region(s), with no transition \
+             between joints (see each joint's reason in the decomposition)",
             decomposition.regions.len()
         ));
     }

@@ -75,6 +75,9 @@
 //!    correction, vertex by vertex, would tear a piece apart that these rules keep whole
 //!    (a rigid hood whose flared edge lies over the upper arm; docs/measurements.md, "The
 //!    guard against far bones").
+//! 6. **Twins.** Joints at one point that the rules left without any weight, while a
+//!    twin has some, share that twin's weight equally ([`twins`]): nothing in the geometry
+//!    tells them apart, and equal shares are the least wrong whatever the artist chose.
 //!
 //! Inputs: a [`Decomposition`], the decomposed skeleton, its [`Overlaps`]
 //! ([`crate::overlap`]) and the [`Blend`]. Output: [`SurfaceWeights`], weights of every
@@ -92,6 +95,7 @@ pub mod related;
 pub mod siblings;
 pub mod soft_sides;
 pub mod surface_weights;
+pub mod twins;
 
 use crate::decomposition::{BoundaryKind, Decomposition};
 use crate::overlap::Overlaps;
@@ -106,6 +110,7 @@ use related::{region_vertices, related_regions, vertex_bands};
 use siblings::merge_sibling_blends;
 use soft_sides::soft_sides;
 use thiserror::Error;
+use twins::share_among_twins;
 
 pub use surface_weights::{SurfaceWeights, WeightCounts};
 
@@ -160,6 +165,7 @@ pub fn compute_weights(
     );
     let far_bone_vertices = guard_far_bones(decomposition, skeleton, &joint_bones, &mut weights);
     let mut counts = weight_pieces(decomposition, skeleton, overlaps, &mut weights);
+    counts.twins_given_a_share = share_among_twins(skeleton, &owns_skin, &mut weights);
     counts.far_bone_vertices = far_bone_vertices;
     counts.sibling_blend_vertices = sibling_blend_vertices;
     counts.leaf_patches = leaf_patches;

@@ -111,6 +111,7 @@ use crate::overlap::Overlaps;
 use crate::skeleton::bone_tree::BoneTree;
 use crate::skeleton::bones::{bone_segments, nearest_bone_with_distance, NearestBone};
 use crate::skeleton::nearest_point::PointGrid;
+use crate::tolerance::SAME_POINT;
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -747,11 +748,6 @@ fn bones_around(
         .filter(|&(joint, _, _)| nearest.count(joint) as f64 >= least)
         .collect()
 }
-
-/// Two sibling joints closer than this share of the skeleton's diagonal sit at one point
-/// (bind matrices are stored in single precision; inverted, they place such twins a few
-/// millionths apart).
-const SAME_POINT: f64 = 1e-5;
 
 /// The bones of the pieces that enclose a joint left free (module documentation): a joint
 /// with no boundary of its own (the root, an end site, a joint whose surface was not found),

@@ -74,6 +74,9 @@ pub struct WeightCounts {
     pub far_bone_vertices: usize,
     /// Vertices whose sibling blends gave weight to the siblings' common ancestor (step 3c).
     pub sibling_blend_vertices: usize,
+    /// Joints at the point of other joints that the rules left without weight and that
+    /// now share their twins' weight (step 6).
+    pub twins_given_a_share: Vec<u32>,
 }
 
 /// How a piece was weighted.
