@@ -7,6 +7,7 @@
 use crate::cuts::joint_roles::HELPER_REASON;
 use crate::decomposition::{Decomposition, JointDecision, JointStatus};
 use crate::geometry::bounding_box;
+use crate::skeleton::nearest_point::PointGrid;
 use crate::tolerance::NEGLIGIBLE;
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
@@ -90,9 +91,13 @@ pub fn check_placement(
     }
     let mut duplicates = Vec::new();
     let mut zero_bones = Vec::new();
-    for a in 0..joints.len() {
-        for b in a + 1..joints.len() {
-            if joints[a].distance(joints[b]) > same_point {
+    // Pairs found through a grid of the joints: a scan of every pair is quadratic in the
+    // joints (5 · 10⁹ distances for 100,000).
+    let grid = PointGrid::new(&joints);
+    for (a, &point) in joints.iter().enumerate() {
+        for b in grid.within(point, same_point) {
+            let b = b as usize;
+            if b <= a {
                 continue;
             }
             let linked = skeleton.parent(a) == Some(b) || skeleton.parent(b) == Some(a);

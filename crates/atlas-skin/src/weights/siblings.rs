@@ -156,6 +156,17 @@ impl<'a> Family<'a> {
     fn merge_row(&self, p: DVec3, row: &mut Vec<(u32, f64)>) -> bool {
         // Transfers (giver, ancestor, amount) before the scaling c_j.
         let mut transfers: Vec<(usize, u32, f64)> = Vec::new();
+        // Bone distances asked of each joint once per row: a row of many siblings asks
+        // every pair, and their common ancestor may move thousands of bones.
+        let mut known: Vec<(u32, f64)> = Vec::new();
+        let mut distance = |j: u32| match known.iter().find(|e| e.0 == j) {
+            Some(&(_, d)) => d,
+            None => {
+                let d = self.bone_distance(p, j);
+                known.push((j, d));
+                d
+            }
+        };
         for x in 0..row.len() {
             for y in x + 1..row.len() {
                 let ((j, wj), (k, wk)) = (row[x], row[y]);
@@ -168,8 +179,8 @@ impl<'a> Family<'a> {
                 if !self.owns_skin[a as usize] {
                     continue;
                 }
-                let near = self.bone_distance(p, j).min(self.bone_distance(p, k));
-                let ratio = self.bone_distance(p, a) / near;
+                let near = distance(j).min(distance(k));
+                let ratio = distance(a) / near;
                 let reach =
                     1.0 - beta(((ratio - NEAR_RATIO) / (FAR_RATIO - NEAR_RATIO)).clamp(0.0, 1.0));
                 let common = (wj.min(wk) - TAIL).max(0.0) / (1.0 - 2.0 * TAIL);
