@@ -1,7 +1,10 @@
 //! Joints at one point (step 6 of [`super`]): the weight of a class of twins.
 //!
 //! Two joints whose bind positions lie within [`SAME_POINT`] × the skeleton's diagonal of
-//! each other are twins; twins of twins belong to one class. Every rule of the method
+//! each other and that are siblings or parent and child are twins; twins of twins belong
+//! to one class. (A joint elsewhere in the tree at the same point, an IK target parented
+//! to the root at the hand, moves on its own: sharing the hand's weight with it would drag
+//! the skin.) Every rule of the method
 //! sees a class as one point: no plane, section or bone length tells their parts apart.
 //! The rules give a class's weight to some of its joints and leave others, that move skin
 //! too, without any weight at all: two eye-lid joints at the centre of one eye (the lid
@@ -48,7 +51,11 @@ pub fn share_among_twins(
     let mut has_twin = false;
     for j in (0..bind.len()).filter(|&j| moves_skin(j)) {
         for k in grid.within(bind[j], radius) {
-            if k as usize != j && moves_skin(k as usize) {
+            let k_ = k as usize;
+            let kin = skeleton.parent(k_) == skeleton.parent(j)
+                || skeleton.parent(k_) == Some(j)
+                || skeleton.parent(j) == Some(k_);
+            if k_ != j && kin && moves_skin(k_) {
                 classes.union(j as u32, k);
                 has_twin = true;
             }
@@ -191,6 +198,21 @@ mod tests {
             assert_eq!(j, k);
             assert!((w - x).abs() < 1e-12, "{row:?}");
         }
+    }
+
+    #[test]
+    fn a_joint_at_the_point_but_elsewhere_in_the_tree_is_no_twin() {
+        // j3, a target parented to the root, sits at the point of j2, the child of j1.
+        let skeleton = Skeleton::from_positions(
+            (0..4).map(|j| format!("j{j}")).collect(),
+            vec![NO_PARENT, 0, 1, 0],
+            &[Vec3::ZERO, Vec3::Y, 2.0 * Vec3::Y, 2.0 * Vec3::Y],
+        )
+        .unwrap();
+        let before = weights_of(&[&[(2, 1.0)], &[(1, 0.5), (2, 0.5)]]);
+        let mut weights = before.clone();
+        assert!(share_among_twins(&skeleton, &[true; 4], &mut weights).is_empty());
+        assert_eq!(weights, before);
     }
 
     #[test]
