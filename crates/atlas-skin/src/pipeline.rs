@@ -23,6 +23,7 @@ use crate::skeleton::bones::{bone_segments, capped_extensions, nearest_bone, EXT
 use crate::skeleton::hierarchy::infer_hierarchy;
 use crate::skeleton::placement::{check_placement, decomposition_warnings, listed, PlacementError};
 use crate::weights::blend::Blend;
+use crate::weights::twins::LARGEST_CLASS;
 use crate::weights::{compute_weights, SurfaceWeights, WeightCounts, WeightsError};
 use atlas_skin_runtime::{RuntimeError, Skeleton, VertexWeights};
 use glam::{DVec3, Vec3};
@@ -265,6 +266,13 @@ pub fn skin(
                     .iter()
                     .map(|&j| skeleton.names[j as usize].clone())
             )
+        ));
+    }
+    if weight_counts.twins_too_many_to_share > 0 {
+        warnings.push(format!(
+            "{} joints sit at one point in classes of more than {LARGEST_CLASS}: their \
+             weight is not shared among them, each keeps what the rules gave it",
+            weight_counts.twins_too_many_to_share
         ));
     }
     let weights = unweld_weights(

@@ -102,8 +102,15 @@ impl<'a> JointsOnSegments<'a> {
     /// The point of the segment from joint j to `end` at the `count`-th other joint lying
     /// on it, counted from j; `None` when fewer lie on it. Joints are visited nearest to j
     /// first, so a leaf among thousands of joints on one line visits about 2 · `count`.
+    ///
+    /// A segment no longer than the tolerance (a leaf at its parent's point) is never cut
+    /// short: a stop on it would lie within twice the tolerance of j, and the visit would
+    /// see every joint at that point (all of a skeleton bound at one point, for each leaf).
     fn kth_on(&self, j: usize, end: DVec3, count: usize) -> Option<DVec3> {
         let start = self.positions[j];
+        if start.distance(end) <= self.tolerance {
+            return None;
+        }
         let direction = (end - start).normalize_or_zero();
         let reach = start.distance(end) + self.tolerance;
         let mut seen = 0;

@@ -89,10 +89,11 @@ pub fn check_placement(
             listed(beside.iter().map(|&j| name(j).to_string()))
         ));
     }
-    let mut duplicates = Vec::new();
-    let mut zero_bones = Vec::new();
+    let mut duplicates = Listed::default();
+    let mut zero_bones = Listed::default();
     // Pairs found through a grid of the joints: a scan of every pair is quadratic in the
-    // joints (5 · 10⁹ distances for 100,000).
+    // joints (5 · 10⁹ distances for 100,000). Only the listed pairs are named: thousands
+    // of joints at one point make millions of pairs.
     let grid = PointGrid::new(&joints);
     for (a, &point) in joints.iter().enumerate() {
         for b in grid.within(point, same_point) {
@@ -101,29 +102,56 @@ pub fn check_placement(
                 continue;
             }
             let linked = skeleton.parent(a) == Some(b) || skeleton.parent(b) == Some(a);
-            let pair = format!("{}/{}", name(a), name(b));
-            if linked {
-                zero_bones.push(pair);
+            let pairs = if linked {
+                &mut zero_bones
             } else {
-                duplicates.push(pair);
-            }
+                &mut duplicates
+            };
+            pairs.push(|| format!("{}/{}", name(a), name(b)));
         }
     }
-    if !duplicates.is_empty() {
+    if duplicates.count > 0 {
         warnings.push(format!(
             "{} pair(s) of joints that are not parent and child sit at one point: {}",
-            duplicates.len(),
-            listed(duplicates.into_iter())
+            duplicates.count,
+            duplicates.text()
         ));
     }
-    if !zero_bones.is_empty() {
+    if zero_bones.count > 0 {
         warnings.push(format!(
             "{} bone(s) have zero length (no direction to cut across there): {}",
-            zero_bones.len(),
-            listed(zero_bones.into_iter())
+            zero_bones.count,
+            zero_bones.text()
         ));
     }
     Ok(warnings)
+}
+
+/// Items counted, of which the first [`LISTED`] are named.
+#[derive(Default)]
+struct Listed {
+    count: usize,
+    shown: Vec<String>,
+}
+
+impl Listed {
+    /// Counts an item, named by `name` if it is among the first [`LISTED`].
+    fn push(&mut self, name: impl FnOnce() -> String) {
+        if self.shown.len() < LISTED {
+            self.shown.push(name());
+        }
+        self.count += 1;
+    }
+
+    /// The names, comma-separated, and how many more.
+    fn text(&self) -> String {
+        let more = self.count - self.shown.len();
+        if more > 0 {
+            format!("{}, and {more} more", self.shown.join(", "))
+        } else {
+            self.shown.join(", ")
+        }
+    }
 }
 
 /// Warnings about what the decomposition made of the skeleton: most joints outside the
@@ -186,11 +214,10 @@ pub fn decomposition_warnings(decomposition: &Decomposition, forbidden: &[String
 
 /// Up to [`LISTED`] items, comma-separated, and how many more.
 pub(crate) fn listed(items: impl ExactSizeIterator<Item = String>) -> String {
-    let more = items.len().saturating_sub(LISTED);
-    let shown: Vec<String> = items.take(LISTED).collect();
-    if more > 0 {
-        format!("{}, and {more} more", shown.join(", "))
-    } else {
-        shown.join(", ")
+    let count = items.len();
+    Listed {
+        count,
+        shown: items.take(LISTED).collect(),
     }
+    .text()
 }

@@ -165,7 +165,9 @@ pub fn compute_weights(
     );
     let far_bone_vertices = guard_far_bones(decomposition, skeleton, &joint_bones, &mut weights);
     let mut counts = weight_pieces(decomposition, skeleton, overlaps, &mut weights);
-    counts.twins_given_a_share = share_among_twins(skeleton, &owns_skin, &mut weights);
+    let twins = share_among_twins(skeleton, &owns_skin, &mut weights);
+    counts.twins_given_a_share = twins.given;
+    counts.twins_too_many_to_share = twins.too_many;
     counts.far_bone_vertices = far_bone_vertices;
     counts.sibling_blend_vertices = sibling_blend_vertices;
     counts.leaf_patches = leaf_patches;

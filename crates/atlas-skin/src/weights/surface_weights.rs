@@ -77,6 +77,8 @@ pub struct WeightCounts {
     /// Joints at the point of other joints that the rules left without weight and that
     /// now share their twins' weight (step 6).
     pub twins_given_a_share: Vec<u32>,
+    /// Joints of the classes of twins too large to share their weight (step 6).
+    pub twins_too_many_to_share: usize,
 }
 
 /// How a piece was weighted.

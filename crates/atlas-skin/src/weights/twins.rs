@@ -19,7 +19,10 @@
 //! The rule: in a class C of n joints that move skin (not helpers, not forbidden), of
 //! which the set W got some weight and the others none, a vertex's class weight
 //! m = Σ_{j∈W} w_j becomes w_j |W| / n on each j of W and m / n on each other joint of C.
-//! Rows keep their sum; a class whose joints all have weight, or none, is left as it is.
+//! Rows keep their sum; a class whose joints all have weight, or none, is left as it is,
+//! and so is a class of more than [`LARGEST_CLASS`] joints (a skeleton of thousands of
+//! joints bound at one point: shares no vertex can hold, each row as long as the class),
+//! with a warning.
 
 use super::SurfaceWeights;
 use crate::geometry::bounding_box;
@@ -29,15 +32,27 @@ use crate::tolerance::SAME_POINT;
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
 
-/// Shares the weight of every class of twins among its joints (module documentation);
-/// returns the joints given a share, increasing.
+/// The most joints a class of twins may have to share its weight: as many influences as
+/// a vertex of a written glTF holds (`atlas_skin_io`'s `MAX_INFLUENCES`).
+pub const LARGEST_CLASS: usize = 32;
+
+/// What [`share_among_twins`] did.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct TwinShares {
+    /// The joints given a share, increasing.
+    pub given: Vec<u32>,
+    /// The joints of the classes left alone for having more than [`LARGEST_CLASS`] joints.
+    pub too_many: usize,
+}
+
+/// Shares the weight of every class of twins among its joints (module documentation).
 ///
 /// - `owns_skin`: #J flags, false for the joints that move no skin (helpers, forbidden).
 pub fn share_among_twins(
     skeleton: &Skeleton,
     owns_skin: &[bool],
     weights: &mut SurfaceWeights,
-) -> Vec<u32> {
+) -> TwinShares {
     let bind: Vec<DVec3> = skeleton
         .bind_positions()
         .iter()
@@ -62,7 +77,7 @@ pub fn share_among_twins(
         }
     }
     if !has_twin {
-        return Vec::new();
+        return TwinShares::default();
     }
     let mut weighted = vec![false; bind.len()];
     for (&j, &w) in weights.joints.iter().zip(&weights.weights) {
@@ -76,7 +91,12 @@ pub fn share_among_twins(
         size[r] += 1;
         with_weight[r] += usize::from(weighted[j]);
     }
-    let shared = |r: usize| with_weight[r] > 0 && with_weight[r] < size[r];
+    let uneven = |r: usize| with_weight[r] > 0 && with_weight[r] < size[r];
+    let shared = |r: usize| uneven(r) && size[r] <= LARGEST_CLASS;
+    let too_many = (0..bind.len())
+        .filter(|&r| uneven(r) && size[r] > LARGEST_CLASS)
+        .map(|r| size[r])
+        .sum();
     let mut unweighted_of = vec![Vec::new(); bind.len()];
     let mut given = Vec::new();
     for j in (0..bind.len()).filter(|&j| moves_skin(j) && !weighted[j]) {
@@ -87,7 +107,7 @@ pub fn share_among_twins(
         }
     }
     if given.is_empty() {
-        return given;
+        return TwinShares { given, too_many };
     }
     let class_of: Vec<Option<usize>> = (0..bind.len())
         .map(|j| {
@@ -121,7 +141,7 @@ pub fn share_among_twins(
         result.extend_row(kept.into_iter().chain(spread));
     }
     *weights = result;
-    given
+    TwinShares { given, too_many }
 }
 
 #[cfg(test)]
@@ -170,8 +190,8 @@ mod tests {
         let skeleton = skeleton_at(&[p, p, Vec3::new(0.0, 2.0, 0.0), p]);
         let owns_skin = [true, true, true, false];
         let mut weights = weights_of(&[&[(0, 1.0)], &[(0, 0.4), (2, 0.6)], &[(2, 1.0)]]);
-        let given = share_among_twins(&skeleton, &owns_skin, &mut weights);
-        assert_eq!(given, vec![1]);
+        let shares = share_among_twins(&skeleton, &owns_skin, &mut weights);
+        assert_eq!(shares.given, vec![1]);
         assert_eq!(
             rows(&weights),
             vec![
@@ -188,7 +208,7 @@ mod tests {
         let skeleton = skeleton_at(&[p, p, p]);
         let mut weights = weights_of(&[&[(0, 0.75), (1, 0.25)]]);
         assert_eq!(
-            share_among_twins(&skeleton, &[true; 3], &mut weights),
+            share_among_twins(&skeleton, &[true; 3], &mut weights).given,
             vec![2]
         );
         let row = &rows(&weights)[0];
@@ -211,8 +231,36 @@ mod tests {
         .unwrap();
         let before = weights_of(&[&[(2, 1.0)], &[(1, 0.5), (2, 0.5)]]);
         let mut weights = before.clone();
-        assert!(share_among_twins(&skeleton, &[true; 4], &mut weights).is_empty());
+        assert_eq!(
+            share_among_twins(&skeleton, &[true; 4], &mut weights),
+            TwinShares::default()
+        );
         assert_eq!(weights, before);
+    }
+
+    #[test]
+    fn a_class_too_large_to_share_is_left_alone_and_counted() {
+        let n = LARGEST_CLASS + 1;
+        let skeleton = skeleton_at(&vec![Vec3::ZERO; n]);
+        let before = weights_of(&[&[(0, 1.0)]]);
+        let mut weights = before.clone();
+        let shares = share_among_twins(&skeleton, &vec![true; n], &mut weights);
+        assert_eq!(
+            shares,
+            TwinShares {
+                given: Vec::new(),
+                too_many: n
+            }
+        );
+        assert_eq!(weights, before);
+        // One joint fewer: every joint takes an equal share.
+        let skeleton = skeleton_at(&vec![Vec3::ZERO; n - 1]);
+        let mut weights = before.clone();
+        let shares = share_among_twins(&skeleton, &vec![true; n - 1], &mut weights);
+        assert_eq!(shares.given.len(), n - 2);
+        assert!(weights
+            .row(0)
+            .all(|(_, w)| (w - 1.0 / (n - 1) as f64).abs() < 1e-12));
     }
 
     #[test]
@@ -221,7 +269,10 @@ mod tests {
         let before = weights_of(&[&[(0, 0.5), (1, 0.5)], &[(2, 1.0)]]);
         let mut weights = before.clone();
         // 0 and 1 are both weighted; 3 is 10⁻³ from 2, a hundred times the radius.
-        assert!(share_among_twins(&skeleton, &[true; 4], &mut weights).is_empty());
+        assert_eq!(
+            share_among_twins(&skeleton, &[true; 4], &mut weights),
+            TwinShares::default()
+        );
         assert_eq!(weights, before);
     }
 }
