@@ -582,7 +582,8 @@ fn diagonal(points: &[DVec3]) -> f64 {
 ///
 /// Candidates: normals ±x, ±y, ±z and p_i − p_j for sibling joints i, j whose bones have
 /// equal length (within 5%), sibling groups in order until there are more than
-/// `SYMMETRY_CANDIDATES` (a group of many equal siblings is cut there); offset c = median
+/// `SYMMETRY_CANDIDATES` (a group of many equal siblings is cut there, and each group after
+/// `SYMMETRY_PAIRS_IN_GROUP` pairs); offset c = median
 /// of n · p over the joints. Nearest joints from a grid ([`PointGrid`]): about
 /// O(J log J · candidates).
 pub fn infer_symmetry_plane(
@@ -596,8 +597,13 @@ pub fn infer_symmetry_plane(
     }
     let mut normals = vec![DVec3::X, DVec3::Y, DVec3::Z];
     'groups: for siblings in skeleton.children() {
-        for (k, &a) in siblings.iter().enumerate() {
+        let mut examined = 0;
+        'pairs: for (k, &a) in siblings.iter().enumerate() {
             for &b in &siblings[k + 1..] {
+                examined += 1;
+                if examined > SYMMETRY_PAIRS_IN_GROUP {
+                    break 'pairs;
+                }
                 let Some(p) = skeleton.parent(a) else {
                     continue;
                 };
@@ -623,7 +629,16 @@ pub fn infer_symmetry_plane(
     // first of equal minima still wins). 100 siblings on one line give one normal.
     let mut tried = HashSet::new();
     normals.retain(|n| tried.insert(n.to_array().map(f64::to_bits)));
-    let joints = PointGrid::new(positions);
+    // Nearest distances from the distinct points: the same minima, and thousands of joints
+    // at one point (a broken bind pose) do not fill one cell that every query scans.
+    let mut distinct: Vec<DVec3> = positions.to_vec();
+    distinct.sort_unstable_by(|a, b| {
+        (a.x.total_cmp(&b.x))
+            .then(a.y.total_cmp(&b.y))
+            .then(a.z.total_cmp(&b.z))
+    });
+    distinct.dedup();
+    let joints = PointGrid::new(&distinct);
     normals
         .into_iter()
         .filter_map(|normal| {
@@ -657,6 +672,10 @@ const SYMMETRY_CANDIDATES: usize = 24;
 /// And within one group, candidates stop past this many (a hand's fingers give 10 pairs;
 /// 10,000 sibling joints would give 50 million).
 const SYMMETRY_CANDIDATES_IN_GROUP: usize = 100;
+
+/// And a group's pairs are examined up to this many (siblings bound at one point, or of
+/// unequal bones, give no candidate however many pairs are tried).
+const SYMMETRY_PAIRS_IN_GROUP: usize = 10_000;
 
 /// Each joint's mirror twin: the other joint nearest to its reflection through `plane`,
 /// when that lies within `tolerance` × the skeleton's diagonal of the reflection (the
