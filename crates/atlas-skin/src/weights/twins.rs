@@ -4,10 +4,9 @@
 //! each other and that are siblings or parent and child are twins; twins of twins belong
 //! to one class. (A joint elsewhere in the tree at the same point, an IK target parented
 //! to the root at the hand, moves on its own: sharing the hand's weight with it would drag
-//! the skin.) Every rule of the method
-//! sees a class as one point: no plane, section or bone length tells their parts apart.
-//! The rules give a class's weight to some of its joints and leave others, that move skin
-//! too, without any weight at all: two eye-lid joints at the centre of one eye (the lid
+//! the skin.) Every rule of the method sees a class as one point: no plane, section or
+//! bone length tells their parts apart. The rules give a class's weight to some of its
+//! joints and leave others, that move skin too, without any weight at all: two eye-lid joints at the centre of one eye (the lid
 //! goes to one of them), Khronos' SimpleSkin (both joints bound at one point: everything
 //! goes to the root). Which one the artist meant the geometry cannot say, so the weight
 //! is shared: the choice that is least wrong whatever the artist's choice was. With the
@@ -122,8 +121,7 @@ pub fn share_among_twins(
     let mut mass: Vec<(usize, f64)> = Vec::new();
     for v in 0..weights.vertex_count() {
         mass.clear();
-        let row: Vec<(u32, f64)> = weights.row(v).collect();
-        let kept = row.iter().map(|&(j, w)| match class_of[j as usize] {
+        let kept = weights.row(v).map(|(j, w)| match class_of[j as usize] {
             Some(r) => {
                 match mass.iter_mut().find(|(c, _)| *c == r) {
                     Some((_, m)) => *m += w,
