@@ -2,10 +2,44 @@
 //! point, exactly: a uniform grid of a few points per cell, searched in growing shells of
 //! cells until the best distance found cannot be beaten by a farther shell; and the points
 //! within a radius, from the cells of the radius's box. (The nearest bone:
-//! [`super::bone_tree`].)
+//! [`super::bone_tree`].) And the joints that sit at one point, from such a grid.
 
+use crate::geometry::bounding_box;
 use crate::mesh::spatial_index::CentreGrid;
+use crate::tolerance::SAME_POINT;
+use atlas_skin_runtime::Skeleton;
 use glam::{DVec3, IVec3};
+
+/// A skeleton's bind positions, with the joints at each joint's point: those within
+/// [`SAME_POINT`] × the diagonal of the joints' bounding box, found from a grid of them
+/// (no scan of every pair on a skeleton of thousands of joints).
+pub struct JointPoints {
+    /// #J bind positions.
+    pub bind: Vec<DVec3>,
+    grid: PointGrid,
+    radius: f64,
+}
+
+impl JointPoints {
+    pub fn new(skeleton: &Skeleton) -> Self {
+        let bind: Vec<DVec3> = skeleton
+            .bind_positions()
+            .iter()
+            .map(|p| p.as_dvec3())
+            .collect();
+        let (lo, hi) = bounding_box(&bind);
+        Self {
+            grid: PointGrid::new(&bind),
+            radius: SAME_POINT * (hi - lo).length(),
+            bind,
+        }
+    }
+
+    /// The joints at joint j's point, j included, increasing.
+    pub fn at(&self, j: usize) -> Vec<u32> {
+        self.grid.within(self.bind[j], self.radius)
+    }
+}
 
 /// Below this many points a scan is cheaper than the grid's shells.
 const SCAN_BELOW: usize = 64;

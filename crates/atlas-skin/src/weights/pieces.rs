@@ -110,8 +110,7 @@ use crate::mesh::{FaceSpheres, SurfaceMesh};
 use crate::overlap::Overlaps;
 use crate::skeleton::bone_tree::BoneTree;
 use crate::skeleton::bones::{bone_segments, nearest_bone_with_distance, NearestBone};
-use crate::skeleton::nearest_point::PointGrid;
-use crate::tolerance::SAME_POINT;
+use crate::skeleton::nearest_point::JointPoints;
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -763,21 +762,15 @@ fn with_enclosed_joints(
     held: Vec<HeldBones>,
     segments: &[(u32, DVec3, DVec3)],
 ) -> Vec<Vec<(u32, DVec3, DVec3)>> {
-    let bind: Vec<DVec3> = skeleton
-        .bind_positions()
-        .iter()
-        .map(|p| p.as_dvec3())
-        .collect();
+    let joints = JointPoints::new(skeleton);
+    let bind = &joints.bind;
     let mut taken = vec![false; skeleton.len()];
     for segment in held.iter().flat_map(|h| &h.segments) {
         taken[segment.0 as usize] = true;
     }
-    let (lo, hi) = crate::geometry::bounding_box(&bind);
-    let same_point = SAME_POINT * (hi - lo).length();
-    let joints = OnceLock::new();
     let twin = |j: usize| {
-        let grid = joints.get_or_init(|| PointGrid::new(&bind));
-        grid.within(bind[j], same_point)
+        joints
+            .at(j)
             .into_iter()
             .any(|k| k as usize != j && skeleton.parent(k as usize) == skeleton.parent(j))
     };

@@ -1,6 +1,6 @@
 //! Joints at one point (step 6 of [`super`]): the weight of a class of twins.
 //!
-//! Two joints whose bind positions lie within [`SAME_POINT`] × the skeleton's diagonal of
+//! Two joints whose bind positions lie within `SAME_POINT` × the skeleton's diagonal of
 //! each other and that are siblings or parent and child are twins; twins of twins belong
 //! to one class. (A joint elsewhere in the tree at the same point, an IK target parented
 //! to the root at the hand, moves on its own: sharing the hand's weight with it would drag
@@ -24,12 +24,9 @@
 //! with a warning.
 
 use super::SurfaceWeights;
-use crate::geometry::bounding_box;
 use crate::mesh::union_find::UnionFind;
-use crate::skeleton::nearest_point::PointGrid;
-use crate::tolerance::SAME_POINT;
+use crate::skeleton::nearest_point::JointPoints;
 use atlas_skin_runtime::Skeleton;
-use glam::DVec3;
 
 /// The most joints a class of twins may have to share its weight: as many influences as
 /// a vertex of a written glTF holds (`atlas_skin_io`'s `MAX_INFLUENCES`).
@@ -52,19 +49,13 @@ pub fn share_among_twins(
     owns_skin: &[bool],
     weights: &mut SurfaceWeights,
 ) -> TwinShares {
-    let bind: Vec<DVec3> = skeleton
-        .bind_positions()
-        .iter()
-        .map(|p| p.as_dvec3())
-        .collect();
+    let joints = JointPoints::new(skeleton);
+    let count = skeleton.len();
     let moves_skin = |j: usize| owns_skin[j];
-    let (lo, hi) = bounding_box(&bind);
-    let radius = SAME_POINT * (hi - lo).length();
-    let grid = PointGrid::new(&bind);
-    let mut classes = UnionFind::new(bind.len());
+    let mut classes = UnionFind::new(count);
     let mut has_twin = false;
-    for j in (0..bind.len()).filter(|&j| moves_skin(j)) {
-        for k in grid.within(bind[j], radius) {
+    for j in (0..count).filter(|&j| moves_skin(j)) {
+        for k in joints.at(j) {
             let k_ = k as usize;
             let kin = skeleton.parent(k_) == skeleton.parent(j)
                 || skeleton.parent(k_) == Some(j)
@@ -78,27 +69,27 @@ pub fn share_among_twins(
     if !has_twin {
         return TwinShares::default();
     }
-    let mut weighted = vec![false; bind.len()];
+    let mut weighted = vec![false; count];
     for (&j, &w) in weights.joints.iter().zip(&weights.weights) {
         weighted[j as usize] |= w > 0.0;
     }
     // Per class representative: its size n and how many of its joints have weight.
-    let mut size = vec![0usize; bind.len()];
-    let mut with_weight = vec![0usize; bind.len()];
-    for j in (0..bind.len()).filter(|&j| moves_skin(j)) {
+    let mut size = vec![0usize; count];
+    let mut with_weight = vec![0usize; count];
+    for j in (0..count).filter(|&j| moves_skin(j)) {
         let r = classes.find(j as u32) as usize;
         size[r] += 1;
         with_weight[r] += usize::from(weighted[j]);
     }
     let uneven = |r: usize| with_weight[r] > 0 && with_weight[r] < size[r];
     let shared = |r: usize| uneven(r) && size[r] <= LARGEST_CLASS;
-    let too_many = (0..bind.len())
+    let too_many = (0..count)
         .filter(|&r| uneven(r) && size[r] > LARGEST_CLASS)
         .map(|r| size[r])
         .sum();
-    let mut unweighted_of = vec![Vec::new(); bind.len()];
+    let mut unweighted_of = vec![Vec::new(); count];
     let mut given = Vec::new();
-    for j in (0..bind.len()).filter(|&j| moves_skin(j) && !weighted[j]) {
+    for j in (0..count).filter(|&j| moves_skin(j) && !weighted[j]) {
         let r = classes.find(j as u32) as usize;
         if shared(r) {
             unweighted_of[r].push(j as u32);
@@ -108,7 +99,7 @@ pub fn share_among_twins(
     if given.is_empty() {
         return TwinShares { given, too_many };
     }
-    let class_of: Vec<Option<usize>> = (0..bind.len())
+    let class_of: Vec<Option<usize>> = (0..count)
         .map(|j| {
             let r = classes.find(j as u32) as usize;
             (weighted[j] && shared(r)).then_some(r)
