@@ -4,7 +4,9 @@
 mod support;
 
 use atlas_skin_corpus::SIMPLESKIN;
+use atlas_skin_io::gltf::{write_skinned_glb, WriteOptions};
 use atlas_skin_io::{load_character, LoadOptions};
+use glam::{Mat4, Vec3};
 use std::path::Path;
 
 /// The weights `glb` holds, per stored vertex, as (joint name, weight) pairs.
@@ -81,4 +83,37 @@ fn twin_joints_left_without_weight_take_an_equal_share() {
     assert!(shared >= 50, "{shared} vertices shared among twins");
     // Measured 0.0037 / 0.240.
     skinned.assert_deform_below(0.0039, 0.26);
+}
+
+/// The demo's 35 joints bound at one point (a broken file): one class of twins larger than
+/// a written vertex's influences is left as the rules weighted it, and the report counts
+/// its joints beside the warning.
+#[test]
+fn a_class_too_large_to_share_is_counted_in_the_report() {
+    let dir = support::out_dir("joints-at-one-point-too-many");
+    support::atlas_skin_ok(&["demo".as_ref(), "-o".as_ref(), dir.as_os_str()]);
+    let mut character =
+        load_character(&dir.join("demo.glb"), &LoadOptions::default()).expect("demo loads");
+    let weights = character
+        .reference_weights
+        .take()
+        .expect("demo has weights");
+    // A new document from the edited skeleton, not the demo's own rewritten.
+    character.gltf = None;
+    let skeleton = character.skeleton.as_mut().expect("demo has a skeleton");
+    let joints = skeleton.len();
+    skeleton.inverse_bind = vec![Mat4::from_translation(-Vec3::Y); joints];
+    let input = dir.join("demo-at-one-point.glb");
+    write_skinned_glb(&character, &weights, &WriteOptions::default(), &input).expect("write");
+    let (_, report) = support::skin_with_report(&input, &dir, "one-point");
+    let counts = &report["counts"];
+    assert_eq!(counts["twins_too_many_to_share"], joints, "{counts}");
+    assert_eq!(counts["twins_given_a_share"], 0, "{counts}");
+    let warnings = report["warnings"].to_string();
+    assert!(
+        warnings.contains(&format!(
+            "{joints} joints sit at one point in classes of more than 32"
+        )),
+        "{warnings}"
+    );
 }
