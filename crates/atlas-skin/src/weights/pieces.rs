@@ -768,12 +768,12 @@ fn with_enclosed_joints(
     for segment in held.iter().flat_map(|h| &h.segments) {
         taken[segment.0 as usize] = true;
     }
-    let twin = |j: usize| {
-        joints
-            .at(j)
-            .into_iter()
-            .any(|k| k as usize != j && skeleton.parent(k as usize) == skeleton.parent(j))
-    };
+    let mut siblings = joints.sibling_classes(skeleton, |_| true);
+    let mut class_size = vec![0u32; skeleton.len()];
+    for j in 0..skeleton.len() as u32 {
+        class_size[siblings.find(j) as usize] += 1;
+    }
+    let mut twin = |j: usize| class_size[siblings.find(j as u32) as usize] > 1;
     let free: Vec<u32> = (0..skeleton.len())
         .filter(|&j| {
             let decision = &decomposition.joints[j];

@@ -24,7 +24,6 @@
 //! with a warning.
 
 use super::SurfaceWeights;
-use crate::mesh::union_find::UnionFind;
 use crate::skeleton::nearest_point::JointPoints;
 use atlas_skin_runtime::Skeleton;
 
@@ -52,21 +51,17 @@ pub fn share_among_twins(
     let joints = JointPoints::new(skeleton);
     let count = skeleton.len();
     let moves_skin = |j: usize| owns_skin[j];
-    let mut classes = UnionFind::new(count);
-    let mut has_twin = false;
+    let mut classes = joints.sibling_classes(skeleton, moves_skin);
     for j in (0..count).filter(|&j| moves_skin(j)) {
-        for k in joints.at(j) {
-            let k_ = k as usize;
-            let kin = skeleton.parent(k_) == skeleton.parent(j)
-                || skeleton.parent(k_) == Some(j)
-                || skeleton.parent(j) == Some(k_);
-            if k_ != j && kin && moves_skin(k_) {
-                classes.union(j as u32, k);
-                has_twin = true;
+        if let Some(parent) = skeleton.parent(j) {
+            if moves_skin(parent) && joints.same_point(j, parent) {
+                classes.union(j as u32, parent as u32);
             }
         }
     }
-    if !has_twin {
+    // A class is represented by its smallest joint: some joint is not its own
+    // representative exactly when some class has two joints.
+    if (0..count as u32).all(|j| classes.find(j) == j) {
         return TwinShares::default();
     }
     let mut weighted = vec![false; count];
