@@ -78,6 +78,7 @@ struct ReportCounts {
 /// vertex's region, fields in sorted order.
 #[derive(Serialize)]
 struct ReportDecomposition {
+    bone_axis: Option<String>,
     cuts: usize,
     joints: Vec<ReportJoint>,
     regions: Vec<ReportRegion>,
@@ -290,6 +291,7 @@ impl ReportDecomposition {
             })
             .collect();
         ReportDecomposition {
+            bone_axis: report.bone_axis,
             cuts: report.cuts,
             joints,
             regions,

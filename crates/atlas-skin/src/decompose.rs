@@ -24,6 +24,7 @@ use crate::regions::{
     bind_parent_sides, bind_regions, faces_by_region, grow_regions, nearest_bone_joints,
     side_regions,
 };
+use crate::skeleton::bone_axis::infer_bone_axis;
 use crate::skeleton::bone_tree::BoneTree;
 use crate::skeleton::bones::{bone_segments, joint_pairs, BoneIndex};
 use atlas_skin_runtime::Skeleton;
@@ -50,6 +51,7 @@ pub fn decompose(
     let spheres = FaceSpheres::new(mesh);
     let vertex_snap = vertex_snap_distances(mesh, topology, params.snap_fraction);
     let bones = BoneIndex::new(joint_pairs(skeleton, &positions), &positions);
+    let bone_axis = infer_bone_axis(skeleton, &positions, &skeleton.children());
     let plans = plan_joints(
         mesh,
         &topology.vertex_component,
@@ -58,6 +60,7 @@ pub fn decompose(
         &positions,
         &bones,
         &overrides,
+        bone_axis,
         params,
     );
     let cut_surface = CutSurface {
@@ -188,6 +191,7 @@ pub fn decompose(
         boundaries,
         joints,
         shared_sides,
+        bone_axis,
         surface_spheres,
     })
 }

@@ -3,6 +3,7 @@
 
 use crate::mesh::{FaceSpheres, SurfaceMesh, Topology};
 use crate::regions::shared_sides::SharedSide;
+use crate::skeleton::bone_axis::BoneAxis;
 use glam::DVec3;
 use serde::Serialize;
 use std::sync::OnceLock;
@@ -27,6 +28,10 @@ pub struct Decomposition {
     /// Regions that were the child side of the cuts of unrelated joints (a hand fused to
     /// the hip) and were divided among them ([`crate::regions::shared_sides`]).
     pub shared_sides: Vec<SharedSide>,
+    /// The local axis of the skeleton's bind frames that runs along its bones, which gave
+    /// joints without child bones their direction ([`crate::skeleton::bone_axis`]); `None`
+    /// when the frames have none (their directions continue their parents' bones).
+    pub bone_axis: Option<BoneAxis>,
     /// The face index of `surface`, built by the first [`Decomposition::surface_spheres`]
     /// (the holding regions of soft joints and the guard against far bones share it);
     /// empty (`OnceLock::new()`) when the decomposition is made.

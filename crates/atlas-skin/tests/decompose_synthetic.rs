@@ -174,6 +174,62 @@ fn a_leaf_whose_part_runs_on_across_its_bone_owns_it_with_a_cut() {
     }
 }
 
+/// A limb turned twice by right angles, then a foot: a tube along x, up y, and forward z
+/// from the ankle at (3, 6, 0), with the chain hip → knee → shin → ankle (a leaf at the
+/// turn to the foot). With `framed`, every joint's bind frame has its +Y along its bone, the
+/// ankle's along the foot (a Blender rig); otherwise the frames are the world's.
+fn limb_with_foot(framed: bool) -> Decomposition {
+    let points = [
+        DVec3::ZERO,
+        DVec3::X * 3.0,
+        DVec3::new(3.0, 3.0, 0.0),
+        DVec3::new(3.0, 6.0, 0.0),
+        DVec3::new(3.0, 6.0, 3.0),
+    ];
+    let (mesh, _) = capsule_chain(&points, &[], 0.5, 64, 32);
+    let names = ["hip", "knee", "shin", "ankle"].map(String::from).to_vec();
+    let parents = vec![NO_PARENT, 0, 1, 2];
+    let inverse_bind = (0..4)
+        .map(|j| {
+            let along = (points[j + 1] - points[j]).normalize().as_vec3();
+            let rotation = if framed {
+                glam::Quat::from_rotation_arc(Vec3::Y, along)
+            } else {
+                glam::Quat::IDENTITY
+            };
+            glam::Mat4::from_rotation_translation(rotation, points[j].as_vec3()).inverse()
+        })
+        .collect();
+    let rig = Skeleton::new(names, parents, inverse_bind).expect("valid skeleton");
+    let d = run(&mesh, &rig);
+    check_decomposition(&d, true);
+    d
+}
+
+#[test]
+fn a_leaf_takes_its_direction_from_its_bind_frame_when_the_rigs_frames_run_along_its_bones() {
+    let bisector = (DVec3::Y + DVec3::Z).normalize();
+    let ankle_normal = |d: &Decomposition| {
+        let ankle = d.joints.iter().find(|j| j.name == "ankle").expect("ankle");
+        assert_eq!(ankle.status, JointStatus::Cut);
+        d.boundaries[ankle.boundary.expect("cut") as usize].normal
+    };
+    // The ankle's frame points along the foot: it is cut like a chain joint, across the
+    // bisector of its leg bone and its own (a bent tube's joint).
+    let framed = limb_with_foot(true);
+    assert_eq!(framed.bone_axis.map(|a| a.name()).as_deref(), Some("+y"));
+    let angle = ankle_normal(&framed).angle_between(bisector).to_degrees();
+    assert!(angle < 5.0, "{angle}° off the bisector");
+    assert_eq!(framed.report().bone_axis.as_deref(), Some("+y"));
+    // World frames say nothing of the leaf's bone: it continues the leg's, the foot runs
+    // on across it (rule 5 (c)).
+    let world = limb_with_foot(false);
+    assert_eq!(world.bone_axis, None);
+    let angle = ankle_normal(&world).angle_between(bisector).to_degrees();
+    assert!(angle > 20.0, "{angle}° off the bisector");
+    assert_eq!(world.report().bone_axis, None);
+}
+
 #[test]
 fn joints_outside_the_mesh_are_skipped_and_explained() {
     let (mesh, _) = bent_cylinder(0.5, 3.0, 45.0, 24, 16);
@@ -476,6 +532,7 @@ fn joints_on_another_bone_skip_a_search_that_would_find_nothing() {
         &positions,
         &bones,
         &overrides,
+        None,
         &params,
     );
     let surface = CutSurface {

@@ -175,6 +175,7 @@ fn decompose_by_hand(
         boundaries,
         joints,
         shared_sides: Vec::new(),
+        bone_axis: None,
         surface_spheres: Default::default(),
     }
 }

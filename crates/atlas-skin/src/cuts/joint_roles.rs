@@ -33,22 +33,25 @@
 //!    Off the plane (a clavicle with a breast bone, a wrist with five finger bones) a
 //!    branching joint is cut like a chain joint whose lower bone is the mean of its unit
 //!    child directions — for a wrist, the average finger direction (but see rule 7).
-//! 5. A leaf owns geometry when the surface runs on past it. Either test suffices:
-//!    (a) the ray from p_J along the upper bone u leaves the surface from inside (hit face
+//! 5. A leaf owns geometry when the surface runs on past it. Its bone's direction b is
+//!    its bind frame's bone axis when the rig has one ([`crate::skeleton::bone_axis`]: a
+//!    toe pointing forward off a foot bone that points down), else its upper bone u; b
+//!    is also its lower bone l. Either test suffices:
+//!    (a) the ray from p_J along b leaves the surface from inside (hit face
 //!    normal along the ray on an outward-oriented surface) at a distance ≥
 //!    `leaf_extent_ratio` × r, r the joint's surface distance; (b) for a joint inside the
 //!    body (r ≥ a tenth of its bone), the part of the surface nearest to it — vertices v past
-//!    it within 60° of u, (v − p_J) · u ≥ ½ |v − p_J|, nearer to p_J than to every bone not
+//!    it within 60° of b, (v − p_J) · b ≥ ½ |v − p_J|, nearer to p_J than to every bone not
 //!    at J — reaches farther than 2 r from p_J. (b) finds toes beyond the ball of a foot, which (a) misses when the foot
-//!    bone points down into the sole. It is then cut with lower bone = upper bone.
-//!    (c) When that part reaches 2 r only within 75° of u ((v − p_J) · u ≥ ¼ |v − p_J|), it
+//!    bone points down into the sole. It is then cut with lower bone l = b.
+//!    (c) When that part reaches 2 r only within 75° of b ((v − p_J) · b ≥ ¼ |v − p_J|), it
 //!    is a foot without toe joints whose leaf sits at the ankle (the foot runs forward across
 //!    a leg bone pointing down), or a part off the bone that is not the leaf's (a prop
 //!    target beside a hand): the leaf is cut when a closed cut fits and is an end site
 //!    otherwise, never a soft boundary ([`JointPlan::CutOrSkip`]).
-//!    (d) When (a) does not hold, for a joint at any depth: that part (within 60° of u),
-//!    taken on the piece around the leaf's bone (the connected piece of the surface nearest
-//!    to the bone's middle), reaches at least the joint's bone length ℓ from p_J. The joint
+//!    (d) When (a) does not hold, for a joint at any depth: that part (within 60° of b),
+//!    taken on the piece around the leaf's upper bone (the connected piece of the surface
+//!    nearest to that bone's middle), reaches at least the joint's bone length ℓ from p_J. The joint
 //!    is then cut like (a) and (b), and where no cut fits its soft boundary is seeded
 //!    farther than at other leaves ([`JointFrame::leaf_part_past`]). This finds leaves in the
 //!    skin, where r is about 0 and (b) does not apply: a tail tip in a flat sheet that runs
@@ -77,6 +80,9 @@ use super::params::{DecomposeParams, Override};
 use crate::geometry::point_segment_distance;
 use crate::mesh::spatial_index::FaceSpheres;
 use crate::mesh::SurfaceMesh;
+#[cfg(doc)]
+use crate::skeleton::bone_axis::infer_bone_axis;
+use crate::skeleton::bone_axis::BoneAxis;
 use crate::skeleton::bones::BoneIndex;
 use crate::skeleton::nearest_point::PointGrid;
 use crate::tolerance::NEGLIGIBLE;
@@ -183,7 +189,9 @@ const FOLD_BACK_COSINE: f64 = 0.5;
 
 /// Decides, for every joint of `skeleton` (bind positions `positions`, bones `bones`),
 /// whether it gets a boundary; `overrides` has one entry per joint, `pieces` the connected
-/// piece of every vertex of `mesh` ([`crate::mesh::Topology::vertex_component`]).
+/// piece of every vertex of `mesh` ([`crate::mesh::Topology::vertex_component`]),
+/// `bone_axis` the [`infer_bone_axis`] of the skeleton's bind frames (the direction of a
+/// joint without child bones).
 #[allow(clippy::too_many_arguments)]
 pub fn plan_joints(
     mesh: &SurfaceMesh,
@@ -193,6 +201,7 @@ pub fn plan_joints(
     positions: &[DVec3],
     bones: &BoneIndex,
     overrides: &[Option<Override>],
+    bone_axis: Option<BoneAxis>,
     params: &DecomposeParams,
 ) -> Vec<JointPlan> {
     let symmetry = infer_symmetry_plane(skeleton, positions, params.symmetry_tolerance);
@@ -203,6 +212,7 @@ pub fn plan_joints(
         skeleton,
         positions,
         children: skeleton.children(),
+        bone_axis,
         scale: diagonal(positions).max(f64::MIN_POSITIVE),
         symmetry,
         twins: mirror_twins(symmetry, positions, params.symmetry_tolerance),
@@ -225,6 +235,8 @@ struct Rig<'a> {
     skeleton: &'a Skeleton,
     positions: &'a [DVec3],
     children: Vec<Vec<usize>>,
+    /// The bind frames' bone axis: the direction of a joint without child bones.
+    bone_axis: Option<BoneAxis>,
     /// Diagonal of the joints' bounding box.
     scale: f64,
     symmetry: Option<SymmetryPlane>,
@@ -328,7 +340,11 @@ impl Rig<'_> {
                 .sum::<DVec3>()
                 .normalize_or_zero()
         };
-        let lower = lower_direction(upper, &child_vectors);
+        let own_axis = self
+            .bone_axis
+            .filter(|_| child_vectors.is_empty())
+            .and_then(|axis| axis.direction(self.skeleton, j));
+        let lower = own_axis.unwrap_or_else(|| lower_direction(upper, &child_vectors));
         if upper == DVec3::ZERO {
             return None;
         }
@@ -433,17 +449,17 @@ fn leaf_part(
     orientation: f64,
     extent_ratio: f64,
 ) -> LeafPart {
-    let (p, upper, radius) = (frame.position, frame.upper, frame.surface_distance);
+    let (p, bone, radius) = (frame.position, frame.lower, frame.surface_distance);
     let threshold = extent_ratio * radius;
     let exit_along_bone = spheres
-        .first_hit(mesh, p, upper)
-        .filter(|hit| orientation * mesh.scaled_normal(hit.face as usize).dot(upper) >= 0.0);
+        .first_hit(mesh, p, bone)
+        .filter(|hit| orientation * mesh.scaled_normal(hit.face as usize).dot(bone) >= 0.0);
     if exit_along_bone.is_some_and(|hit| hit.distance >= threshold) {
         return LeafPart::Owned;
     }
     // (d), on the piece around the leaf's bone: the one nearest to the bone's middle.
     let bone_piece = spheres
-        .nearest_point(mesh, p - 0.5 * frame.bone_length * upper)
+        .nearest_point(mesh, p - 0.5 * frame.bone_length * frame.upper)
         .map(|nearest| pieces[mesh.triangles[nearest.face as usize][0] as usize]);
     if let Some(piece) = bone_piece {
         let on_piece = Some((pieces, piece));
@@ -451,7 +467,7 @@ fn leaf_part(
             mesh,
             spheres,
             p,
-            upper,
+            bone,
             frame.bone_length,
             &other_bones,
             on_piece,
@@ -467,7 +483,7 @@ fn leaf_part(
         mesh,
         spheres,
         p,
-        upper,
+        bone,
         LEAF_REACH_RATIO * radius,
         other_bones,
         None,
@@ -787,30 +803,35 @@ mod tests {
         assert!(infer_symmetry_plane(&skeleton, &positions, 0.02).is_none());
     }
 
-    /// Rule 5 at the bend of a tube of radius ½ bent by `bend` degrees, the leaf's bone
-    /// coming up the first segment: the second segment is the part past the leaf. The bone
-    /// is taken as 4 long, longer than that part (3 and a cap), as a leg bone is longer
-    /// than the foot past its ankle: (d) does not apply.
-    fn leaf_part_at_bend(bend: f64) -> LeafPart {
+    /// Rule 5 at the bend of a tube of radius ½ bent by `bend` degrees, the leaf's upper
+    /// bone coming up the first segment: the second segment is the part past the leaf. The
+    /// bone is taken as 4 long, longer than that part (3 and a cap), as a leg bone is longer
+    /// than the foot past its ankle: (d) does not apply. The leaf's own direction is its
+    /// upper bone's, or with `framed` the second segment's (as a bind frame gives it).
+    fn leaf_part_at_bend(bend: f64, framed: bool) -> LeafPart {
         let (mesh, _) = crate::fixtures::shapes::bent_cylinder(0.5, 3.0, bend, 24, 16);
         let pieces = vec![0; mesh.vertex_count()];
-        leaf_part_of(&mesh, &pieces, DVec3::Y * 3.0, DVec3::Y, 4.0)
+        let turned = DVec3::new(bend.to_radians().sin(), bend.to_radians().cos(), 0.0);
+        let lower = if framed { turned } else { DVec3::Y };
+        leaf_part_of(&mesh, &pieces, DVec3::Y * 3.0, DVec3::Y, lower, 4.0)
     }
 
-    /// Rule 5 for a leaf at `position` of `mesh` (pieces `pieces`), its bone of length
-    /// `bone_length` along the unit `upper`, with no other bone near.
+    /// Rule 5 for a leaf at `position` of `mesh` (pieces `pieces`), its upper bone of length
+    /// `bone_length` along the unit `upper`, its own direction the unit `lower`, with no
+    /// other bone near.
     fn leaf_part_of(
         mesh: &SurfaceMesh,
         pieces: &[u32],
         position: DVec3,
         upper: DVec3,
+        lower: DVec3,
         bone_length: f64,
     ) -> LeafPart {
         let spheres = FaceSpheres::new(mesh);
         let frame = JointFrame {
             position,
             upper,
-            lower: upper,
+            lower,
             bone_length,
             surface_distance: spheres.nearest_distance(mesh, position),
             on_mirror_plane: false,
@@ -832,11 +853,20 @@ mod tests {
     #[test]
     fn a_part_turned_across_the_leafs_bone_is_the_leafs_only_with_a_cut() {
         // Toes beyond the ball of a foot: within 60° of the bone.
-        assert_eq!(leaf_part_at_bend(45.0), LeafPart::Owned);
+        assert_eq!(leaf_part_at_bend(45.0, false), LeafPart::Owned);
         // A foot forward of an ankle whose leg bone points down into the sole.
-        assert_eq!(leaf_part_at_bend(90.0), LeafPart::OffAxis);
+        assert_eq!(leaf_part_at_bend(90.0, false), LeafPart::OffAxis);
         // A straight tube ends at its cap: the ray along the bone leaves it a radius away.
-        assert_eq!(leaf_part_at_bend(0.0), LeafPart::Owned);
+        assert_eq!(leaf_part_at_bend(0.0, false), LeafPart::Owned);
+    }
+
+    #[test]
+    fn a_leaf_whose_frame_points_along_the_part_past_it_owns_it() {
+        // The ankle's bind frame points along the foot: the ray along it runs through the
+        // foot, and the foot is the ankle's as toes past a ball are.
+        for bend in [0.0, 45.0, 90.0, 120.0] {
+            assert_eq!(leaf_part_at_bend(bend, true), LeafPart::Owned, "{bend}°");
+        }
     }
 
     /// Rule 5 at a leaf lying just above a flat sheet (a tail modelled as one layer of
@@ -871,7 +901,7 @@ mod tests {
             strip(0.0, length, 0);
         }
         let position = DVec3::new(0.0, 0.001, -1.0);
-        leaf_part_of(&mesh, &pieces, position, DVec3::NEG_Z, 1.0)
+        leaf_part_of(&mesh, &pieces, position, DVec3::NEG_Z, DVec3::NEG_Z, 1.0)
     }
 
     #[test]
