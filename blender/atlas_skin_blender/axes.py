@@ -25,3 +25,13 @@ def to_gltf_axes(points, matrix=None):
         m = np.asarray(matrix, dtype=np.float64)
         points = points @ m[:3, :3].T + m[:3, 3]
     return points @ BLENDER_TO_GLTF.T
+
+
+def frames_to_gltf_axes(matrices):
+    """(N, 4, 4) bone frames (local to armature, e.g. Bone.matrix_local) -> (N, 4, 4)
+    float64 local to armature in glTF's axes: the bones' own axes kept (a Blender bone's +Y
+    still runs from its head to its tail), their images turned into glTF's axes."""
+    frames = np.asarray(matrices, dtype=np.float64).reshape(-1, 4, 4)
+    to_gltf = np.eye(4)
+    to_gltf[:3, :3] = BLENDER_TO_GLTF
+    return to_gltf @ frames

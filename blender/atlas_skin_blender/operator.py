@@ -123,6 +123,7 @@ class OBJECT_OT_parent_atlas_skin(bpy.types.Operator):
                 rig.heads,
                 rig.parents,
                 tails=rig.tails if self.use_tails else None,
+                inverse_bind=rig.inverse_bind,
                 **options,
             )
             seconds = time.perf_counter() - start

@@ -4,7 +4,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .axes import to_gltf_axes
+from .axes import frames_to_gltf_axes, to_gltf_axes
 
 
 class RigError(Exception):
@@ -18,12 +18,16 @@ class Rig:
     names: J bone names; heads, tails: (J, 3) float64 positions of each bone's head and
     tail at rest (the armature's space, glTF's axes); parents: (J,) int64, the index of
     the nearest deforming ancestor or -1 for a root. Parents come before their children.
+    inverse_bind: (J, 4, 4) float64, the inverse of each bone's rest frame in the same
+    space (its +Y along the bone, as Blender's bones and glTF files made by Blender have
+    it): a leaf bone's direction for the method.
     """
 
     names: list
     heads: np.ndarray
     tails: np.ndarray
     parents: np.ndarray
+    inverse_bind: np.ndarray
 
 
 def deforming_rig(armature):
@@ -47,4 +51,5 @@ def deforming_rig(armature):
         heads=to_gltf_axes([b.head_local for b in bones]),
         tails=to_gltf_axes([b.tail_local for b in bones]),
         parents=parents,
+        inverse_bind=np.linalg.inv(frames_to_gltf_axes([b.matrix_local for b in bones])),
     )

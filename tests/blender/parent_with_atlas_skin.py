@@ -9,7 +9,8 @@ skeleton, all imported with Blender's glTF importer and their weights removed:
 - every vertex is in at least one bone group, the weights of each vertex sum to 1, at most
   4 per vertex; a group that names no bone is kept; every mesh has the armature as parent
   and one Armature modifier;
-- the weights equal those `atlas-skin skin` writes for the same file, within 1e-5 (the glb
+- the weights equal those `atlas-skin skin` writes for the same file, within 1e-4 (the
+  bones' frames pass through Blender's float32 edit bones: skinned.CLI_TOLERANCE; the glb
   it writes is the input document with new weights, so Blender imports the same vertices
   in the same order);
 - turning each deforming bone in pose mode moves its part and nothing else;

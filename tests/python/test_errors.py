@@ -52,6 +52,18 @@ def test_values_that_are_not_finite(demo):
         weights(demo, tails=tails)
 
 
+def test_bind_frames_that_disagree_with_the_joints(demo):
+    frames = demo["inverse_bind"].copy()
+    with pytest.raises(ValueError, match=r"inverse_bind must have shape \(35, 4, 4\), got \(3, 4, 4\)"):
+        weights(demo, inverse_bind=frames[:3])
+    frames[5, 0, 3] += 1.0
+    with pytest.raises(ValueError, match=r"inverse_bind\[5\] places joint .* not at joint_positions\[5\]"):
+        weights(demo, inverse_bind=frames)
+    frames[5, 0, 3] = np.nan
+    with pytest.raises(ValueError, match=r"inverse_bind\[5\] is not finite"):
+        weights(demo, inverse_bind=frames)
+
+
 def test_a_skeleton_without_joints(demo):
     with pytest.raises(ValueError, match="joint_positions is empty: a skeleton needs at least one joint"):
         weights(demo, joint_positions=np.zeros((0, 3)), parents=np.zeros(0, np.int64))

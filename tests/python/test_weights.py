@@ -22,6 +22,7 @@ def weights_of(character, **options):
         character["joint_positions"],
         character["parents"],
         tails=character["tails"],
+        inverse_bind=character["inverse_bind"],
         names=character["names"],
         end_joints=character["end_joints"],
         **options,

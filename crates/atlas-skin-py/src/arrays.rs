@@ -240,13 +240,13 @@ pub fn vertex_weights(
 
 /// `(J, 4, 4)` finite matrices acting on column vectors (`p' = M @ [x, y, z, 1]`).
 pub fn palette(value: &Bound<'_, PyAny>) -> PyResult<Vec<Mat4>> {
-    let values = read::<f64>(
-        value,
-        "palette",
-        &[None, Some(4), Some(4)],
-        "J44",
-        Kind::Float,
-    )?;
+    matrices(value, "palette", None)
+}
+
+/// `(count, 4, 4)` (any count when `None`) finite matrices acting on column vectors, the
+/// argument named `name` in messages.
+pub fn matrices(value: &Bound<'_, PyAny>, name: &str, count: Option<usize>) -> PyResult<Vec<Mat4>> {
+    let values = read::<f64>(value, name, &[count, Some(4), Some(4)], "J44", Kind::Float)?;
     values
         .data
         .chunks_exact(16)
@@ -257,7 +257,7 @@ pub fn palette(value: &Bound<'_, PyAny>) -> PyResult<Vec<Mat4>> {
             if matrix.is_finite() {
                 Ok(matrix)
             } else {
-                Err(PyValueError::new_err(format!("palette[{j}] is not finite")))
+                Err(PyValueError::new_err(format!("{name}[{j}] is not finite")))
             }
         })
         .collect()

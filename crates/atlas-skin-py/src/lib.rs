@@ -89,12 +89,14 @@ fn json_object<'py>(py: Python<'py>, value: &serde_json::Value) -> PyResult<Boun
         .call_method1("loads", (value.to_string(),))
 }
 
-/// The skeleton of `compute_weights`: positions, parents, optional names and tails.
+/// The skeleton of `compute_weights`: positions, parents, optional names, tails and bind
+/// frames.
 fn skeleton_from_arrays(
     joint_positions: &Bound<'_, PyAny>,
     parents: &Bound<'_, PyAny>,
     names: Option<Vec<String>>,
     tails: Option<&Bound<'_, PyAny>>,
+    inverse_bind: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Skeleton> {
     let positions = arrays::points(joint_positions, "joint_positions", 'J')?;
     let count = positions.len();
@@ -121,7 +123,15 @@ fn skeleton_from_arrays(
         )));
     }
     let invalid = |e| PyValueError::new_err(format!("invalid skeleton: {e}"));
-    let skeleton = Skeleton::from_positions(names, parents, &positions).map_err(invalid)?;
+    let skeleton = match inverse_bind {
+        Some(matrices) => {
+            let matrices = arrays::matrices(matrices, "inverse_bind", Some(count))?;
+            let skeleton = Skeleton::new(names, parents, matrices).map_err(invalid)?;
+            check_bind_positions(&skeleton, &positions)?;
+            skeleton
+        }
+        None => Skeleton::from_positions(names, parents, &positions).map_err(invalid)?,
+    };
     match tails {
         Some(tails) => skeleton
             .with_tails(arrays::optional_points(tails, "tails", count)?)
@@ -130,11 +140,31 @@ fn skeleton_from_arrays(
     }
 }
 
+/// The bind positions of `skeleton` (its frames' translations) are `positions`, to 10⁻⁴ of
+/// their bounding box's diagonal (float32 matrices inverted).
+fn check_bind_positions(skeleton: &Skeleton, positions: &[Vec3]) -> PyResult<()> {
+    let (low, high) = positions.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(low, high), &p| (low.min(p), high.max(p)),
+    );
+    let tolerance = 1e-4 * low.distance(high).max(1e-6);
+    let bind = skeleton.bind_positions();
+    match (0..positions.len()).find(|&j| bind[j].distance(positions[j]) > tolerance) {
+        Some(j) => Err(PyValueError::new_err(format!(
+            "inverse_bind[{j}] places joint {} at {:?}, not at joint_positions[{j}] {:?}",
+            skeleton.names[j],
+            bind[j].to_array(),
+            positions[j].to_array()
+        ))),
+        None => Ok(()),
+    }
+}
+
 #[allow(clippy::too_many_arguments)]
 #[pyfunction]
 #[pyo3(signature = (
-    vertices, triangles, joint_positions, parents, *, tails=None, names=None,
-    end_joints=None, **options
+    vertices, triangles, joint_positions, parents, *, tails=None, inverse_bind=None,
+    names=None, end_joints=None, **options
 ))]
 fn compute_weights<'py>(
     py: Python<'py>,
@@ -143,13 +173,14 @@ fn compute_weights<'py>(
     joint_positions: &Bound<'py, PyAny>,
     parents: &Bound<'py, PyAny>,
     tails: Option<&Bound<'py, PyAny>>,
+    inverse_bind: Option<&Bound<'py, PyAny>>,
     names: Option<Vec<String>>,
     end_joints: Option<Vec<i64>>,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyTuple>> {
     let positions = arrays::points(vertices, "vertices", 'V')?;
     let triangles = arrays::triangles(triangles, positions.len())?;
-    let skeleton = skeleton_from_arrays(joint_positions, parents, names, tails)?;
+    let skeleton = skeleton_from_arrays(joint_positions, parents, names, tails, inverse_bind)?;
     let end_joints = end_joints
         .unwrap_or_default()
         .into_iter()

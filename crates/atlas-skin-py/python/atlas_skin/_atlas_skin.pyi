@@ -53,6 +53,7 @@ def compute_weights(
     parents: IntArray,
     *,
     tails: Optional[FloatArray] = None,
+    inverse_bind: Optional[FloatArray] = None,
     names: Optional[Sequence[str]] = None,
     end_joints: Optional[Sequence[int]] = None,
     **options: Unpack[MethodOptions],
@@ -73,6 +74,11 @@ def compute_weights(
     - ``tails``: ``(J, 3)`` floats, the far end of each joint's bone (a Blender bone's
       tail); a row of NaN means none. Only leaf joints use it: their bone runs from the
       joint to its tail (without one, it continues the parent's bone by half its length).
+    - ``inverse_bind``: ``(J, 4, 4)`` floats, the inverse of each joint's bind frame
+      (``M[row, column]`` acting on column vectors, as ``load`` returns them); their
+      translations must place the joints at ``joint_positions``. When the frames run along
+      the bones (a Blender or Maya rig), a leaf joint takes its direction from its frame
+      (the report's ``decomposition.bone_axis``); without them every frame is the world's.
     - ``names``: ``J`` unique joint names (default ``joint0``, ``joint1``, ...): the names
       that ``overlap_joints``, ``force`` and ``forbid`` use, and that the report shows.
     - ``end_joints``: joints that move nothing (the leaves of a TGF skeleton, libigl's
@@ -118,8 +124,9 @@ def load(
       float32 arrays (``K``: the most influences of any vertex), or None.
 
     ``compute_weights(c["positions"], c["triangles"], c["joint_positions"], c["parents"],
-    tails=c["tails"], names=c["names"], end_joints=c["end_joints"])`` gives the weights of
-    ``atlas-skin skin`` on the same file.
+    tails=c["tails"], inverse_bind=c["inverse_bind"], names=c["names"],
+    end_joints=c["end_joints"])`` gives the weights of ``atlas-skin skin`` on the same
+    file.
 
     Raises ``FileNotFoundError`` for a missing file, ``ValueError`` for any other problem
     (the message names the file).
