@@ -9,8 +9,13 @@
 //!    either lost on the benchmark (rignet-val/7571's shoulders cut through the neck beside
 //!    its locators; docs/measurements.md, "Helper joints by name"). Forced by the user: a
 //!    boundary, whatever follows.
-//! 2. A root has no upper bone to cut: its region is the root region. A joint whose bones
-//!    all have zero length has no direction to cut across: no boundary.
+//! 2. A root has no upper bone to cut: its region is the root region. But a root outside
+//!    the mesh (the ray vote of rule 3) whose one child that is not a helper (rule 1) lies
+//!    inside it is a *motion root*, the joint at the floor under the hips that game rigs
+//!    (Blender's and Unreal's `root`) move the whole character by: it moves no skin
+//!    ([`JointPlan::Exclude`]), and the region around its child is the child's
+//!    (docs/measurements.md, "Motion roots"). A joint whose bones all have zero length has
+//!    no direction to cut across: no boundary.
 //! 3. A joint lies outside the mesh and owns no geometry when it is farther from the
 //!    surface than `outside_ratio` × its longest bone and outside it: most of six rays from
 //!    it (±x, ±y, ±z, slightly turned) first meet the surface from outside, or not at all.
@@ -212,6 +217,7 @@ pub fn plan_joints(
         skeleton,
         positions,
         children: skeleton.children(),
+        overrides,
         bone_axis,
         scale: diagonal(positions).max(f64::MIN_POSITIVE),
         symmetry,
@@ -222,7 +228,7 @@ pub fn plan_joints(
     };
     (0..skeleton.len())
         .into_par_iter()
-        .map(|j| rig.plan(j, overrides[j]))
+        .map(|j| rig.plan(j, rig.overrides[j]))
         .collect()
 }
 
@@ -235,6 +241,8 @@ struct Rig<'a> {
     skeleton: &'a Skeleton,
     positions: &'a [DVec3],
     children: Vec<Vec<usize>>,
+    /// The user's and the helper names' overrides, one per joint.
+    overrides: &'a [Option<Override>],
     /// The bind frames' bone axis: the direction of a joint without child bones.
     bone_axis: Option<BoneAxis>,
     /// Diagonal of the joints' bounding box.
@@ -266,6 +274,12 @@ impl Rig<'_> {
             _ => {}
         }
         if self.skeleton.parent(j).is_none() && !forced {
+            if let Some(child) = self.motion_root_child(j) {
+                return JointPlan::Exclude(format!(
+                    "motion root: outside the mesh, its one child {} inside it",
+                    self.skeleton.names[child]
+                ));
+            }
             return JointPlan::Skip("root joint: no upper bone to cut".into());
         }
         let Some(bones) = self.bones_at(j) else {
@@ -314,6 +328,18 @@ impl Rig<'_> {
             }
         }
         JointPlan::Boundary(frame)
+    }
+
+    /// The child of root `root` when the root is a motion root (rule 2): outside the mesh,
+    /// with one child that is not a helper, inside the mesh.
+    fn motion_root_child(&self, root: usize) -> Option<usize> {
+        let is_helper = |c: usize| self.overrides[c] == Some(Override::Helper);
+        let mut deforming = self.children[root].iter().filter(|&&c| !is_helper(c));
+        let (Some(&child), None) = (deforming.next(), deforming.next()) else {
+            return None;
+        };
+        let inside = |p: DVec3| is_inside_by_rays(self.mesh, self.spheres, p, self.orientation);
+        (!inside(self.positions[root]) && inside(self.positions[child])).then_some(child)
     }
 
     /// The frame of joint `j` (rules 1–3 and 7): upper and lower directions, bone lengths, the
