@@ -230,18 +230,18 @@ fn a_leaf_takes_its_direction_from_its_bind_frame_when_the_rigs_frames_run_along
     assert_eq!(world.report().bone_axis, None);
 }
 
-/// A body as a tube from y = 1 to y = 4 (radius ½, capped), rigged from a root at
-/// `root_y` on its axis: root → hips (y = 1.5) → chest (y = 3), and with `second_child` a
-/// second child of the root beside the hips (y = 1.5, x = 0.2).
+/// A body as a tube from y = 1 to y = 4 (radius ½, capped: its skin runs from y = 0.5 to
+/// 4.5), rigged from a root at `root_y` on its axis: root → hips (y = 1) → chest (y = 3),
+/// and with `second_child` a second child of the root beside the hips (x = 0.2).
 fn body_on_a_root(root_y: f64, second_child: bool) -> Decomposition {
     let (mesh, _) = capsule_chain(&[DVec3::Y, DVec3::Y * 4.0], &[], 0.5, 24, 24);
     let mut names = vec!["root", "hips", "chest"];
     let mut parents = vec![NO_PARENT, 0, 1];
-    let mut positions = vec![DVec3::Y * root_y, DVec3::Y * 1.5, DVec3::Y * 3.0];
+    let mut positions = vec![DVec3::Y * root_y, DVec3::Y, DVec3::Y * 3.0];
     if second_child {
         names.push("side");
         parents.push(0);
-        positions.push(DVec3::new(0.2, 1.5, 0.0));
+        positions.push(DVec3::new(0.2, 1.0, 0.0));
     }
     let d = run(&mesh, &skeleton(&names, &parents, &positions));
     check_decomposition(&d, true);
@@ -253,8 +253,9 @@ fn a_root_at_the_floor_under_the_body_is_a_motion_root_and_moves_no_skin() {
     let joint = |d: &Decomposition, name: &str| {
         d.joints.iter().position(|j| j.name == name).expect("joint")
     };
-    // The root at the floor, 0.5 under the body's lowest point, its one child inside.
-    let d = body_on_a_root(0.0, false);
+    // The root at the floor, 1.5 under the body's lowest point, its one child inside, its
+    // bone through the air but for its last quarter.
+    let d = body_on_a_root(-1.0, false);
     let root = &d.joints[joint(&d, "root")];
     assert!(
         matches!(&root.status, JointStatus::Skipped(r) if r.starts_with("motion root") && r.contains("hips")),
@@ -268,12 +269,14 @@ fn a_root_at_the_floor_under_the_body_is_a_motion_root_and_moves_no_skin() {
         .region
         .expect("hips lie in a region");
     assert_eq!(d.regions[region as usize].joints.first(), Some(&hips));
-    // A root inside the body, or with two children, is the root region's joint.
-    for d in [body_on_a_root(1.2, false), body_on_a_root(0.0, true)] {
+    // A root inside the body, just outside its end with its bone inside, or with two
+    // children, is the root region's joint.
+    for (root_y, second_child) in [(1.2, false), (0.45, false), (-1.0, true)] {
+        let d = body_on_a_root(root_y, second_child);
         let root = &d.joints[joint(&d, "root")];
         assert!(
             matches!(&root.status, JointStatus::Skipped(r) if r.starts_with("root joint")),
-            "{:?}",
+            "root at {root_y}: {:?}",
             root.status
         );
         assert!(root.owns_skin);

@@ -11,10 +11,12 @@
 //!    boundary, whatever follows.
 //! 2. A root has no upper bone to cut: its region is the root region. But a root outside
 //!    the mesh (the ray vote of rule 3) whose one child that is not a helper (rule 1) lies
-//!    inside it is a *motion root*, the joint at the floor under the hips that game rigs
-//!    (Blender's and Unreal's `root`) move the whole character by: it moves no skin
-//!    ([`JointPlan::Exclude`]), and the region around its child is the child's
-//!    (docs/measurements.md, "Motion roots"). A joint whose bones all have zero length has
+//!    inside it, its bone reaching the body through the air (at most half of 8 points
+//!    along it inside), is a *motion root*, the joint at the floor under the hips that
+//!    game rigs (Blender's and Unreal's `root`) move the whole character by: it moves no
+//!    skin ([`JointPlan::Exclude`]), and the region around its child is the child's
+//!    (docs/measurements.md, "Motion roots"). A root just outside the end of a tube whose
+//!    bone runs inside it keeps the tube's end. A joint whose bones all have zero length has
 //!    no direction to cut across: no boundary.
 //! 3. A joint lies outside the mesh and owns no geometry when it is farther from the
 //!    surface than `outside_ratio` × its longest bone and outside it: most of six rays from
@@ -187,6 +189,9 @@ const INTERIOR_RADIUS: f64 = 0.1;
 /// (docs/measurements.md).
 const SPREAD_MEAN_LENGTH: f64 = std::f64::consts::FRAC_1_SQRT_2;
 
+/// Points along a root's bone (between its ends) that rule 2 asks the ray vote about.
+const MOTION_ROOT_SAMPLES: usize = 8;
+
 /// Rule 7: spread children fold back when their mean direction makes more than 120° with
 /// the upper bone (cos 60° = ½; ¼ gives the same weights on the benchmark, 0 catches
 /// joints whose children spread sideways and less than 95° from the upper bone).
@@ -331,7 +336,8 @@ impl Rig<'_> {
     }
 
     /// The child of root `root` when the root is a motion root (rule 2): outside the mesh,
-    /// with one child that is not a helper, inside the mesh.
+    /// with one child that is not a helper, inside the mesh, and at most half of
+    /// [`MOTION_ROOT_SAMPLES`] points along the bone between them inside.
     fn motion_root_child(&self, root: usize) -> Option<usize> {
         let is_helper = |c: usize| self.overrides[c] == Some(Override::Helper);
         let mut deforming = self.children[root].iter().filter(|&&c| !is_helper(c));
@@ -339,7 +345,16 @@ impl Rig<'_> {
             return None;
         };
         let inside = |p: DVec3| is_inside_by_rays(self.mesh, self.spheres, p, self.orientation);
-        (!inside(self.positions[root]) && inside(self.positions[child])).then_some(child)
+        let (from, to) = (self.positions[root], self.positions[child]);
+        if inside(from) || !inside(to) {
+            return None;
+        }
+        // Its bone reaches the body through the air: most of it lies outside.
+        let samples = MOTION_ROOT_SAMPLES;
+        let inside_bone = (1..=samples)
+            .filter(|&k| inside(from.lerp(to, k as f64 / (samples + 1) as f64)))
+            .count();
+        (2 * inside_bone <= samples).then_some(child)
     }
 
     /// The frame of joint `j` (rules 1–3 and 7): upper and lower directions, bone lengths, the
