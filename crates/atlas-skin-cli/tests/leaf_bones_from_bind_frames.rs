@@ -53,3 +53,25 @@ fn world_frames_leave_leaves_on_their_parents_bones() {
     let (report, _, _) = skinned("rignet-val/1168");
     assert!(report["decomposition"]["bone_axis"].is_null(), "{report}");
 }
+
+/// `inspect` names the axis before anything is skinned, in text and JSON.
+#[test]
+fn inspect_names_the_bone_axis() {
+    let inspect = |name: &str, json: bool| {
+        let input = atlas_skin_corpus::data_dir().join(format!("bench/{name}.glb"));
+        let mut args = vec!["inspect".into(), input.into_os_string()];
+        if json {
+            args.push("--json".into());
+        }
+        String::from_utf8(support::atlas_skin_ok(&args).stdout).unwrap()
+    };
+    let text = inspect("kaykit/Barbarian", false);
+    assert!(
+        text.contains("bone axis:             +y of the bind frames"),
+        "{text}"
+    );
+    let text = inspect("rignet-val/1168", false);
+    assert!(text.contains("bone axis:             none"), "{text}");
+    let json: serde_json::Value = serde_json::from_str(&inspect("kaykit/Barbarian", true)).unwrap();
+    assert_eq!(json["bone_axis"], "+y");
+}
