@@ -11,8 +11,9 @@ use glam::DVec3;
 /// artist's weights.
 fn skinned(name: &str) -> (serde_json::Value, serde_json::Value, std::path::PathBuf) {
     let input = atlas_skin_corpus::data_dir().join(format!("bench/{name}.glb"));
-    let dir = support::out_dir("leaf-bones-from-bind-frames");
     let stem = name.replace('/', "-");
+    // One folder per character: the tests run in parallel and `out_dir` empties it.
+    let dir = support::out_dir(&format!("leaf-bones-from-bind-frames-{stem}"));
     let (glb, report) = support::skin_with_report(&input, &dir, &stem);
     let deform = support::deform_random(&input, &glb);
     (report, deform, input)

@@ -25,8 +25,9 @@ fn without_weight(report: &serde_json::Value) -> Vec<String> {
 /// weight; returns the deformation figures against the artist's weights.
 fn soft_joint_carrying_weight(name: &str, joint: &str) -> serde_json::Value {
     let character = atlas_skin_corpus::data_dir().join("bench").join(name);
-    let dir = support::out_dir("soft-joints-on-coarse-faces");
     let stem = character.file_stem().unwrap().to_str().unwrap();
+    // One folder per character: the tests run in parallel and `out_dir` empties it.
+    let dir = support::out_dir(&format!("soft-joints-on-coarse-faces-{stem}"));
     let (glb, report) = support::skin_with_report(&character, &dir, stem);
     let joints = report["decomposition"]["joints"].as_array().unwrap();
     let decision = joints.iter().find(|j| j["name"] == joint).unwrap();
@@ -45,7 +46,7 @@ fn the_knights_hips_bend_its_pelvis_and_a_jaw_in_the_mouth_stays_inactive() {
     assert!(deform["mean"].as_f64().unwrap() < 0.0045, "{deform}");
 
     let bench = atlas_skin_corpus::data_dir().join("bench");
-    let dir = support::out_dir("soft-joints-on-coarse-faces");
+    let dir = support::out_dir("soft-joints-on-coarse-faces-4331");
     let (_, report) = support::skin_with_report(&bench.join("rignet-val/4331.glb"), &dir, "4331");
     assert!(
         without_weight(&report).contains(&"Jaw".to_string()),

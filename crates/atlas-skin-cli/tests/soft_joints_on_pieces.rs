@@ -10,7 +10,7 @@ mod support;
 #[test]
 fn robotexpressive_hands_follow_the_forearm_and_the_palm_joints_bend_them() {
     let input = atlas_skin_corpus::data_dir().join("bench/robotexpressive/RobotExpressive.glb");
-    let dir = support::out_dir("soft-joints-on-pieces");
+    let dir = support::out_dir("soft-joints-on-pieces-robot");
     let (glb, report) = support::skin_with_report(&input, &dir, "robot");
     let decomposition = &report["decomposition"];
     let joints = decomposition["joints"].as_array().unwrap();
@@ -50,7 +50,7 @@ fn robotexpressive_hands_follow_the_forearm_and_the_palm_joints_bend_them() {
 #[test]
 fn a_spine_joint_is_held_by_the_dress_its_section_runs_around() {
     let input = atlas_skin_corpus::data_dir().join("bench/rignet-val/7063.glb");
-    let dir = support::out_dir("soft-joints-on-pieces");
+    let dir = support::out_dir("soft-joints-on-pieces-7063");
     let (glb, report) = support::skin_with_report(&input, &dir, "7063");
     let decomposition = &report["decomposition"];
     let joints = decomposition["joints"].as_array().unwrap();

@@ -161,7 +161,8 @@ pub fn count_and_deform(
     (counted, deform_random(&input, &glb))
 }
 
-/// A fresh, empty output folder for one test under the target's test temp dir.
+/// A fresh, empty output folder for one test under the target's test temp dir. It is
+/// emptied first, so no two tests of one binary (they run in parallel) may share `test`.
 pub fn out_dir(test: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
         .join("cli_tests")
