@@ -77,3 +77,36 @@ fn a_spine_joint_is_held_by_the_dress_its_section_runs_around() {
     // Measured 0.0130; the spine held by the belt gave 0.0149.
     assert!(deform["mean"].as_f64().unwrap() < 0.014, "{deform}");
 }
+
+/// A soft joint with child bones that neither its section nor its parent's region places
+/// is held by the region around its own bones (`regions::holding`, step 3):
+/// rignet-val/9866, whose torso is one piece and its legs another. The thigh joints sit
+/// beside the torso's hem, which dips into the legs' piece; their every closed section
+/// also encloses the other leg. Held by the hem, the nearest face, their soft boundaries
+/// found no vertex of it near them and carried no weight: both thighs moved with the
+/// waist (deform mean 0.0030, max 0.080, at a knee).
+#[test]
+fn thigh_joints_beside_a_hem_are_held_by_the_legs_around_their_bones() {
+    let input = atlas_skin_corpus::data_dir().join("bench/rignet-val/9866.glb");
+    let dir = support::out_dir("soft-joints-on-pieces-9866");
+    let (glb, report) = support::skin_with_report(&input, &dir, "9866");
+    let decomposition = &report["decomposition"];
+    let joints = decomposition["joints"].as_array().unwrap();
+    let joint = |name: &str| joints.iter().find(|j| j["name"] == name).unwrap();
+    let warnings = report["warnings"].to_string();
+    for side in ["L", "R"] {
+        let thigh = joint(&format!("{side}Thigh"));
+        assert_eq!(thigh["status"], "soft", "{thigh}");
+        // The legs' region above the knees, where the waist's other bones end: its
+        // root's region.
+        assert_eq!(thigh["region"], joint("Waist")["region"], "{thigh}");
+        assert!(
+            !warnings.contains(&format!("{side}Thigh")),
+            "{side}Thigh carries no weight: {warnings}"
+        );
+    }
+    let deform = support::deform_random(&input, &glb);
+    // Measured 0.0019 / 0.026.
+    assert!(deform["mean"].as_f64().unwrap() < 0.0024, "{deform}");
+    assert!(deform["max"].as_f64().unwrap() < 0.05, "{deform}");
+}

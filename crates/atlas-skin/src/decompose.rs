@@ -18,7 +18,7 @@ use crate::cuts::plane_section::{diameter, vertex_snap_distances, ScratchPool};
 use crate::cuts::split::split_along_curves;
 use crate::decomposition::{Boundary, BoundaryKind, Decomposition, JointDecision, JointStatus};
 use crate::mesh::{FaceSpheres, SurfaceMesh, Topology};
-use crate::regions::holding::HoldingRegions;
+use crate::regions::holding::{own_bone_points, HoldingRegions};
 use crate::regions::shared_sides::{divide_shared_sides, ChildSide};
 use crate::regions::{
     bind_parent_sides, bind_regions, faces_by_region, grow_regions, nearest_bone_joints,
@@ -51,7 +51,8 @@ pub fn decompose(
     let spheres = FaceSpheres::new(mesh);
     let vertex_snap = vertex_snap_distances(mesh, topology, params.snap_fraction);
     let bones = BoneIndex::new(joint_pairs(skeleton, &positions), &positions);
-    let bone_axis = infer_bone_axis(skeleton, &positions, &skeleton.children());
+    let children = skeleton.children();
+    let bone_axis = infer_bone_axis(skeleton, &positions, &children);
     let plans = plan_joints(
         mesh,
         &topology.vertex_component,
@@ -152,7 +153,8 @@ pub fn decompose(
             let section = searches[j].candidates.first();
             let (_, _, diameter) = section_geometry(frame, section);
             let points = section.map_or(&[][..], |c| &c.points[..]);
-            holders.holding_region(frame.position, points, diameter, parent_region)
+            let own = own_bone_points(frame.position, children[j].iter().map(|&c| positions[c]));
+            holders.holding_region(frame.position, points, diameter, parent_region, &own)
         }
         _ => parent_region,
     };
