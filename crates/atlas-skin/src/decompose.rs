@@ -312,14 +312,10 @@ fn decide_joints(
                 },
                 Outcome::Skip(reason) => return skipped(name, reason),
             };
-            boundaries.push(boundary_geometry(
-                j,
-                &frame,
-                section,
-                kind,
-                parent_region,
-                child_region,
-            ));
+            boundaries.push(Boundary {
+                bone_through: searches[j].through_joint.is_some(),
+                ..boundary_geometry(j, &frame, section, kind, parent_region, child_region)
+            });
             JointDecision {
                 name,
                 status,
@@ -393,7 +389,7 @@ fn search_all_cuts(surface: &CutSurface, bones: &BoneIndex, plans: &[JointPlan])
 /// Plane, perimeter and diameter of a boundary from `section`: the placed section of a cut,
 /// the best closed section of a soft boundary. Without one the normal is the bisector of
 /// the bones and the section a circle of the joint's surface distance r (perimeter 2πr,
-/// diameter 2r).
+/// diameter 2r). No bone through the joint (the caller knows).
 fn boundary_geometry(
     joint: usize,
     frame: &JointFrame,
@@ -413,6 +409,7 @@ fn boundary_geometry(
         parent_region,
         child_region,
         leaf_part_past: frame.leaf_part_past,
+        bone_through: false,
     }
 }
 

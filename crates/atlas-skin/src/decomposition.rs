@@ -92,6 +92,10 @@ pub struct Boundary {
     /// 5 (d) of [`crate::cuts::joint_roles`]): a soft boundary of it is seeded farther
     /// ([`crate::cuts::joint_roles::JointFrame::leaf_part_past`]).
     pub leaf_part_past: bool,
+    /// Another bone runs through the joint (or from it) and crosses every plane searched
+    /// there ([`crate::cuts::plane_search::CutSearch::through_joint`]): nothing in the
+    /// geometry places the joint's own part apart from that bone's.
+    pub bone_through: bool,
 }
 
 /// Why a joint has the boundary it has, for the report.

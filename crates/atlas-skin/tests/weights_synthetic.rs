@@ -118,6 +118,7 @@ fn decompose_by_hand(
             parent_region: sides[0],
             child_region: sides[1],
             leaf_part_past: false,
+            bone_through: false,
         });
     }
     let mut regions: Vec<Region> = bound
@@ -148,6 +149,7 @@ fn decompose_by_hand(
             parent_region: region,
             child_region: region,
             leaf_part_past: false,
+            bone_through: false,
         });
     }
     let joints = (0..skeleton.len() as u32)

@@ -56,7 +56,13 @@ impl SoftSide {
 /// distance from the joint to the nearest vertex of the surface; for such a leaf, failing
 /// those, the far ends of their edges as above (a tail tip in a flat sheet: its band is as
 /// thin as the joint's depth, 2r, and one face spans it; for joints with child bones this
-/// last step lost on the benchmark, docs/measurements.md). A soft boundary with no
+/// last step lost on the benchmark, docs/measurements.md). Where still none qualifies, a
+/// joint with child bones that no region is bound to and that no other bone runs through
+/// (a hair card's or a tail's joint beside a sheet, whose band is as thin as its depth)
+/// is seeded from its own part: the vertices of its region on the child side of its plane
+/// (n·(p − o) > 0) where its own bones are clearly the nearest (κ = 1). Else its region's
+/// bound joint moved the whole chain, at bones twice as far as its own
+/// (docs/measurements.md, "Own parts of chains on sheets"). A soft boundary with no
 /// cross-section (diameter 0, or no seed: face bones in a mouth cavity or an eye socket,
 /// whose leaf joints are not seeded farther) is inactive: its joint gets no weight and its
 /// region's other joints keep it.
@@ -86,6 +92,13 @@ pub fn soft_sides(
         .count();
     let vertices = NearVertices::new(&d.surface.positions, soft_boundaries);
     let children = skeleton.children();
+    // Joints that a region is bound to move skin whatever their soft boundary does.
+    let mut bound = vec![false; skeleton.len()];
+    for region in &d.regions {
+        if let Some(&joint) = region.joints.first() {
+            bound[joint as usize] = true;
+        }
+    }
     d.boundaries
         .par_iter()
         .enumerate()
@@ -95,9 +108,11 @@ pub fn soft_sides(
             let owner = Ownership::new(&bones, b.joint as usize, b.parent_region, half_width);
             let beyond = owner.beyond(&free, b.joint as usize);
             let in_region = |v: usize| related.row(v).iter().any(|&(r, _)| r == b.parent_region);
+            let has_children = !children[b.joint as usize].is_empty();
             let seeds = Seeds {
                 vertices: &vertices,
-                beyond_nearest: !children[b.joint as usize].is_empty() || b.leaf_part_past,
+                beyond_nearest: has_children || b.leaf_part_past,
+                own_part: has_children && !b.bone_through && !bound[b.joint as usize],
             };
             child_side(d, b, half_width, &owner, &beyond, in_region, &seeds)
         })
@@ -151,12 +166,14 @@ impl<'a> NearVertices<'a> {
     }
 }
 
-/// Where a soft boundary's flood starts: the surface's vertices as points, and whether the
+/// Where a soft boundary's flood starts: the surface's vertices as points, whether the
 /// seeds may lie beyond the nearest vertex (a joint with child bones, or a leaf whose part
-/// runs on past it).
+/// runs on past it), and whether, failing all else, they may be its own part (a joint with
+/// child bones that no region is bound to and that no other bone runs through).
 struct Seeds<'a> {
     vertices: &'a NearVertices<'a>,
     beyond_nearest: bool,
+    own_part: bool,
 }
 
 /// The child side of the soft boundary `b` (half-width `half_width`, κ from `owner`, π from
@@ -234,6 +251,15 @@ fn child_side(
         if queue.is_empty() && b.leaf_part_past {
             for u in far_ends(&farther) {
                 visit(u, &mut queue);
+            }
+        }
+    }
+    if queue.is_empty() && seeds.own_part {
+        // No vertex near the joint: its own part, where its own bones are clearly the
+        // nearest, on the child side of its plane.
+        for (v, &p) in positions.iter().enumerate() {
+            if in_region(v) && signed(v) > 0.0 && owner.at(p) >= 1.0 {
+                visit(v as u32, &mut queue);
             }
         }
     }
