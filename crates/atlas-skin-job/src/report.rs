@@ -220,18 +220,27 @@ impl<'a> SkinReport<'a> {
 }
 
 /// The report's warnings: the reader's (`input_warnings`), the method's, then the soft
-/// joints that carry no weight and the stored vertices no triangle uses.
+/// joints whose boundary found no cross-section and that carry no weight in the end (a
+/// joint bound to a region, or given weight by a later step, is not named), and the stored
+/// vertices no triangle uses.
 fn report_warnings(input_warnings: &[String], skinned: &Skinned) -> Vec<String> {
     let counts = &skinned.counts;
     let weight_counts = &counts.weights;
     let mut warnings = input_warnings.to_vec();
     warnings.extend(skinned.warnings.iter().cloned());
-    if !weight_counts.inactive_soft_joints.is_empty() {
-        let names: Vec<&str> = weight_counts
-            .inactive_soft_joints
-            .iter()
-            .map(|&j| skinned.decomposition.joints[j as usize].name.as_str())
-            .collect();
+    let mut carries = vec![false; skinned.decomposition.joints.len()];
+    for (&j, &w) in skinned.weights.joints.iter().zip(&skinned.weights.weights) {
+        if w > 0.0 {
+            carries[j as usize] = true;
+        }
+    }
+    let names: Vec<&str> = weight_counts
+        .inactive_soft_joints
+        .iter()
+        .filter(|&&j| !carries[j as usize])
+        .map(|&j| skinned.decomposition.joints[j as usize].name.as_str())
+        .collect();
+    if !names.is_empty() {
         warnings.push(format!(
             "{} soft boundaries have no cross-section near their joint and carry no weight: {}",
             names.len(),
