@@ -133,7 +133,8 @@ pub fn side_regions(
 /// A region whose joint nearest the root lies in it because its parent's region does not
 /// reach it (`holding` moved it there) continues that region across the gap between their
 /// pieces: it is bound to the joint the parent's region is bound to, and the joints it
-/// holds act in it as soft boundaries.
+/// holds act in it as soft boundaries, as do the soft joints between those and the bound
+/// joint (`weights::soft_sides`).
 ///
 /// Returns (#J region of each joint, `None` when the surface is empty; the regions).
 #[allow(clippy::too_many_arguments)]

@@ -14,6 +14,7 @@ use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
 use rayon::prelude::*;
 use rustc_hash::FxHashSet;
+use std::borrow::Cow;
 use std::collections::VecDeque;
 
 /// A soft boundary, ready for step 3.
@@ -43,7 +44,9 @@ impl SoftSide {
     }
 }
 
-/// Step 3's child sides: for each soft boundary, a flood along edges from the vertices of
+/// Step 3's child sides: for each soft boundary (in its region, and in a region that
+/// continues that region across a gap below it: `continued_boundaries`), a flood along
+/// edges from the vertices of
 /// the joint's cross-section (within the band |n·(p − o)| ≤ w and within max(D, w) of the
 /// joint), through vertices related to the boundary's region whose signed plane distance
 /// exceeds −w and where κ > 0 ([`super::ownership`]). Where none of those vertices
@@ -85,12 +88,21 @@ pub fn soft_sides(
     let bones = OwnershipBones::new(skeleton, &d.joints, &segments);
     // The joints of the boundaries below are all handled, as `beyond` requires.
     let free = FreeBones::new(skeleton, &segments, &handled);
-    let soft_boundaries = d
+    // Every soft boundary with a section acts in its region; some also in a region that
+    // continues it across a gap.
+    let acting: Vec<(usize, Cow<Boundary>)> = d
         .boundaries
         .iter()
-        .filter(|b| b.kind == BoundaryKind::Soft && b.diameter > 0.0)
-        .count();
-    let vertices = NearVertices::new(&d.surface.positions, soft_boundaries);
+        .enumerate()
+        .filter(|(_, b)| b.kind == BoundaryKind::Soft && b.diameter > 0.0)
+        .map(|(k, b)| (k, Cow::Borrowed(b)))
+        .chain(
+            continued_boundaries(d, skeleton)
+                .into_iter()
+                .map(|(k, b)| (k, Cow::Owned(b))),
+        )
+        .collect();
+    let vertices = NearVertices::new(&d.surface.positions, acting.len());
     let children = skeleton.children();
     // Joints that a region is bound to move skin whatever their soft boundary does.
     let mut bound = vec![false; skeleton.len()];
@@ -99,11 +111,10 @@ pub fn soft_sides(
             bound[joint as usize] = true;
         }
     }
-    d.boundaries
+    acting
         .par_iter()
-        .enumerate()
-        .filter(|(_, b)| b.kind == BoundaryKind::Soft && b.diameter > 0.0)
         .filter_map(|(k, b)| {
+            let (k, b) = (*k, b.as_ref());
             let half_width = overlaps.half_widths[k];
             let owner = Ownership::new(&bones, b.joint as usize, b.parent_region, half_width);
             let beyond = owner.beyond(&free, b.joint as usize);
@@ -117,6 +128,52 @@ pub fn soft_sides(
             child_side(d, b, half_width, &owner, &beyond, in_region, &seeds)
         })
         .collect()
+}
+
+/// The soft boundaries that also act in a region continuing their region across a gap,
+/// each as (boundary index, the boundary with that region on both sides). A region whose
+/// joint nearest the root was moved there by the holding rule continues its parent's
+/// region and is bound to the joint that region is bound to (`regions::bind_regions`); the
+/// soft joints between that bound joint and a joint the region holds, which lie in the
+/// parent's region, bend it too: a hair piece bound to the neck that holds the ponytail's
+/// second joint also bends at its first, whose joint lies in the head (rignet-val/3615,
+/// docs/measurements.md, "Soft joints above a continued region").
+fn continued_boundaries(d: &Decomposition, skeleton: &Skeleton) -> Vec<(usize, Boundary)> {
+    let mut continued = Vec::new();
+    for (r, region) in d.regions.iter().enumerate() {
+        let r = r as u32;
+        let Some((&bound, held)) = region.joints.split_first() else {
+            continue;
+        };
+        if d.joints[bound as usize].region == Some(r) {
+            continue;
+        }
+        for &h in held {
+            for a in skeleton.ancestors(h as usize) {
+                if a == bound as usize || d.joints[a].region == Some(r) {
+                    break;
+                }
+                let Some(k) = d.joints[a].boundary.map(|k| k as usize) else {
+                    continue;
+                };
+                let b = &d.boundaries[k];
+                if b.kind == BoundaryKind::Soft && b.diameter > 0.0 && b.parent_region != r {
+                    let in_region = Boundary {
+                        parent_region: r,
+                        child_region: r,
+                        ..b.clone()
+                    };
+                    if !continued
+                        .iter()
+                        .any(|(j, c): &(usize, Boundary)| *j == k && c.parent_region == r)
+                    {
+                        continued.push((k, in_region));
+                    }
+                }
+            }
+        }
+    }
+    continued
 }
 
 /// Below this many soft boundaries their seeds come from a scan of the surface's vertices.
