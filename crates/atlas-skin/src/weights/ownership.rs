@@ -87,7 +87,7 @@ impl OwnershipBones {
 
 /// The depth-first position of every joint of `skeleton` and the end of its subtree's
 /// positions (roots in index order, children in index order).
-fn depth_first_ranges(skeleton: &Skeleton) -> (Vec<u32>, Vec<u32>) {
+pub(crate) fn depth_first_ranges(skeleton: &Skeleton) -> (Vec<u32>, Vec<u32>) {
     let children = skeleton.children();
     let (mut order, mut end) = (vec![0u32; skeleton.len()], vec![0u32; skeleton.len()]);
     let mut next = 0u32;

@@ -3,7 +3,7 @@
 //! (module documentation of [`crate::weights`]).
 
 use super::blend::beta;
-use super::ownership::{FreeBones, Ownership, OwnershipBones};
+use super::ownership::{depth_first_ranges, FreeBones, Ownership, OwnershipBones};
 use crate::decomposition::{Boundary, BoundaryKind, Decomposition};
 use crate::geometry::point_segment_distance;
 use crate::overlap::Overlaps;
@@ -65,7 +65,9 @@ impl SoftSide {
 /// is seeded from its own part: the vertices of its region on the child side of its plane
 /// (n·(p − o) > 0) where its own bones are clearly the nearest (κ = 1). Else its region's
 /// bound joint moved the whole chain, at bones twice as far as its own
-/// (docs/measurements.md, "Own parts of chains on sheets"). A soft boundary with no
+/// (docs/measurements.md, "Own parts of chains on sheets"); such a side leaves alone the
+/// vertices where a side below it in its region takes the whole share, which takes its
+/// mass there anyway (the sides are found deepest joint first). A soft boundary with no
 /// cross-section (diameter 0, or no seed: face bones in a mouth cavity or an eye socket,
 /// whose leaf joints are not seeded farther) is inactive: its joint gets no weight and its
 /// region's other joints keep it.
@@ -111,23 +113,86 @@ pub fn soft_sides(
             bound[joint as usize] = true;
         }
     }
-    acting
-        .par_iter()
-        .filter_map(|(k, b)| {
-            let (k, b) = (*k, b.as_ref());
-            let half_width = overlaps.half_widths[k];
-            let owner = Ownership::new(&bones, b.joint as usize, b.parent_region, half_width);
-            let beyond = owner.beyond(&free, b.joint as usize);
-            let in_region = |v: usize| related.row(v).iter().any(|&(r, _)| r == b.parent_region);
-            let has_children = !children[b.joint as usize].is_empty();
-            let seeds = Seeds {
-                vertices: &vertices,
-                beyond_nearest: has_children || b.leaf_part_past,
-                own_part: has_children && !b.bone_through && !bound[b.joint as usize],
-            };
-            child_side(d, b, half_width, &owner, &beyond, in_region, &seeds)
+    let side = |(k, b): &(usize, Cow<Boundary>), taken: &Taken| {
+        let (k, b) = (*k, b.as_ref());
+        let half_width = overlaps.half_widths[k];
+        let owner = Ownership::new(&bones, b.joint as usize, b.parent_region, half_width);
+        let beyond = owner.beyond(&free, b.joint as usize);
+        let in_region = |v: usize| related.row(v).iter().any(|&(r, _)| r == b.parent_region);
+        let has_children = !children[b.joint as usize].is_empty();
+        let seeds = Seeds {
+            vertices: &vertices,
+            beyond_nearest: has_children || b.leaf_part_past,
+            own_part: has_children && !b.bone_through && !bound[b.joint as usize],
+        };
+        let below = |v: usize| taken.below(v, b.parent_region, b.joint);
+        child_side(d, b, half_width, &owner, &beyond, in_region, below, &seeds)
+    };
+    // The deepest joints first, those at one depth in parallel: where a joint's side takes
+    // the whole share (s = 1), it takes the mass of every joint above it on its region's
+    // chain (module documentation of `weights`, step 3), so the sides of those joints need
+    // not reach there. Without this a chain of thousands of soft joints along a sheet,
+    // each reaching every vertex below it, cost the product of joints and vertices.
+    let depth: Vec<usize> = (0..skeleton.len())
+        .map(|j| skeleton.ancestors(j).count())
+        .collect();
+    let mut by_depth: Vec<usize> = (0..acting.len()).collect();
+    by_depth.sort_by_key(|&i| std::cmp::Reverse(depth[acting[i].1.joint as usize]));
+    let mut taken = Taken::new(skeleton, d.surface.vertex_count());
+    let mut sides: Vec<(usize, SoftSide)> = Vec::with_capacity(acting.len());
+    for level in by_depth
+        .chunk_by(|&a, &b| depth[acting[a].1.joint as usize] == depth[acting[b].1.joint as usize])
+    {
+        let found: Vec<(usize, SoftSide)> = level
+            .par_iter()
+            .filter_map(|&i| side(&acting[i], &taken).map(|s| (i, s)))
+            .collect();
+        for (_, s) in &found {
+            taken.record(s, &d.surface.positions);
+        }
+        sides.extend(found);
+    }
+    sides.sort_unstable_by_key(|&(i, _)| i);
+    sides.into_iter().map(|(_, s)| s).collect()
+}
+
+/// Per vertex, a soft side that takes the whole share there (s = 1), by its region and
+/// joint: the deepest recorded first ([`soft_sides`]).
+struct Taken {
+    /// #J depth-first position of every joint, and the end of its subtree's positions.
+    order: Vec<u32>,
+    subtree_end: Vec<u32>,
+    /// #V (region, joint) of a side with s = 1 at the vertex.
+    by: Vec<Option<(u32, u32)>>,
+}
+
+impl Taken {
+    fn new(skeleton: &Skeleton, vertex_count: usize) -> Self {
+        let (order, subtree_end) = depth_first_ranges(skeleton);
+        Self {
+            order,
+            subtree_end,
+            by: vec![None; vertex_count],
+        }
+    }
+
+    /// Records where `side` takes the whole share, where no side did before.
+    fn record(&mut self, side: &SoftSide, positions: &[DVec3]) {
+        for &(v, kappa, beyond) in side.reached() {
+            let slot = &mut self.by[v as usize];
+            if slot.is_none() && side.share(positions[v as usize], kappa, beyond) >= 1.0 {
+                *slot = Some((side.region, side.joint));
+            }
+        }
+    }
+
+    /// Whether a side of a joint below `joint` in `region` takes the whole share at `v`.
+    fn below(&self, v: usize, region: u32, joint: u32) -> bool {
+        self.by[v].is_some_and(|(r, d)| {
+            let (c, d) = (joint as usize, d as usize);
+            r == region && self.order[c] < self.order[d] && self.order[d] < self.subtree_end[c]
         })
-        .collect()
+    }
 }
 
 /// The soft boundaries that also act in a region continuing their region across a gap,
@@ -237,6 +302,7 @@ struct Seeds<'a> {
 /// `beyond`): the flood of [`soft_sides`] from the vertices near the joint (found in
 /// `seeds`), through vertices where `in_region` holds (those the region reaches); `None`
 /// when no seed qualifies (an inactive boundary).
+#[allow(clippy::too_many_arguments)]
 fn child_side(
     d: &Decomposition,
     b: &Boundary,
@@ -244,6 +310,7 @@ fn child_side(
     owner: &Ownership,
     beyond: &Ownership,
     in_region: impl Fn(usize) -> bool,
+    taken_below: impl Fn(usize) -> bool,
     seeds: &Seeds,
 ) -> Option<SoftSide> {
     let positions = &d.surface.positions;
@@ -252,13 +319,15 @@ fn child_side(
     // per vertex of the surface: thousands of soft boundaries each reach a few vertices;
     // hashed by Fx: the keys are vertex indices, not input an attacker chooses.)
     let mut examined = FxHashSet::default();
+    // Seeded from its own part, the side leaves alone where a side below takes all.
+    let own_part = std::cell::Cell::new(false);
     let mut reached = Vec::new();
     let mut queue = VecDeque::new();
     let mut visit = |v: u32, queue: &mut VecDeque<u32>| {
         if !examined.insert(v) {
             return;
         }
-        if !in_region(v as usize) {
+        if !in_region(v as usize) || (own_part.get() && taken_below(v as usize)) {
             return;
         }
         let p = positions[v as usize];
@@ -314,8 +383,9 @@ fn child_side(
     if queue.is_empty() && seeds.own_part {
         // No vertex near the joint: its own part, where its own bones are clearly the
         // nearest, on the child side of its plane.
+        own_part.set(true);
         for (v, &p) in positions.iter().enumerate() {
-            if in_region(v) && signed(v) > 0.0 && owner.at(p) >= 1.0 {
+            if signed(v) > 0.0 && !taken_below(v) && in_region(v) && owner.at(p) >= 1.0 {
                 visit(v as u32, &mut queue);
             }
         }
