@@ -413,6 +413,30 @@ fn child_side(
 mod tests {
     use super::*;
     use atlas_skin_runtime::random_pose::SplitMix64;
+    use atlas_skin_runtime::NO_PARENT;
+
+    /// A side stops only where a side of a joint strictly below its own, in its own
+    /// region, takes the whole share: root → a → b and root → c.
+    #[test]
+    fn a_side_stops_only_where_a_side_below_it_in_its_region_takes_all() {
+        let names = ["root", "a", "b", "c"].map(String::from).to_vec();
+        let positions = [0.0, 1.0, 2.0, 3.0].map(|y| glam::Vec3::new(0.0, y, 0.0));
+        let skeleton = Skeleton::from_positions(names, vec![NO_PARENT, 0, 1, 0], &positions)
+            .expect("skeleton");
+        let mut taken = Taken::new(&skeleton, 2);
+        taken.by[0] = Some((5, 2));
+        for (region, joint, below) in [
+            (5, 1, true),
+            (5, 0, true),
+            (5, 2, false),
+            (5, 3, false),
+            (4, 1, false),
+        ] {
+            assert_eq!(taken.below(0, region, joint), below, "{region} {joint}");
+        }
+        // Nothing taken at vertex 1.
+        assert!(!taken.below(1, 5, 0));
+    }
 
     /// The scan of the vertices finds what the grid of the vertices finds, at radii of 0, at
     /// a vertex's exact distance (on the ball's boundary), just inside it and at random.
