@@ -133,9 +133,12 @@ pub fn soft_sides(
     // chain (module documentation of `weights`, step 3), so the sides of those joints need
     // not reach there. Without this a chain of thousands of soft joints along a sheet,
     // each reaching every vertex below it, cost the product of joints and vertices.
-    let depth: Vec<usize> = (0..skeleton.len())
-        .map(|j| skeleton.ancestors(j).count())
-        .collect();
+    let mut depth = vec![0usize; skeleton.len()];
+    for j in skeleton.topological_order() {
+        if let Some(p) = skeleton.parent(j) {
+            depth[j] = depth[p] + 1;
+        }
+    }
     let mut by_depth: Vec<usize> = (0..acting.len()).collect();
     by_depth.sort_by_key(|&i| std::cmp::Reverse(depth[acting[i].1.joint as usize]));
     let mut taken = Taken::new(skeleton, d.surface.vertex_count());
