@@ -87,13 +87,9 @@ fn a_spine_joint_is_held_by_the_dress_its_section_runs_around() {
 /// waist (deform mean 0.0030, max 0.080, at a knee).
 #[test]
 fn thigh_joints_beside_a_hem_are_held_by_the_legs_around_their_bones() {
-    let input = atlas_skin_corpus::data_dir().join("bench/rignet-val/9866.glb");
-    let dir = support::out_dir("soft-joints-on-pieces-9866");
-    let (glb, report) = support::skin_with_report(&input, &dir, "9866");
-    let decomposition = &report["decomposition"];
-    let joints = decomposition["joints"].as_array().unwrap();
-    let joint = |name: &str| joints.iter().find(|j| j["name"] == name).unwrap();
-    let warnings = report["warnings"].to_string();
+    let skinned = support::BenchSkin::new("rignet-val/9866", "soft-joints-on-pieces-9866");
+    let joint = |name: &str| skinned.joint(name);
+    let warnings = skinned.report["warnings"].to_string();
     for side in ["L", "R"] {
         let thigh = joint(&format!("{side}Thigh"));
         assert_eq!(thigh["status"], "soft", "{thigh}");
@@ -105,7 +101,7 @@ fn thigh_joints_beside_a_hem_are_held_by_the_legs_around_their_bones() {
             "{side}Thigh carries no weight: {warnings}"
         );
     }
-    let deform = support::deform_random(&input, &glb);
+    let deform = support::deform_random(&skinned.input, &skinned.glb);
     // Measured 0.0019 / 0.026.
     assert!(deform["mean"].as_f64().unwrap() < 0.0024, "{deform}");
     assert!(deform["max"].as_f64().unwrap() < 0.05, "{deform}");

@@ -312,10 +312,15 @@ fn decide_joints(
                 },
                 Outcome::Skip(reason) => return skipped(name, reason),
             };
-            boundaries.push(Boundary {
-                bone_through: searches[j].through_joint.is_some(),
-                ..boundary_geometry(j, &frame, section, kind, parent_region, child_region)
-            });
+            boundaries.push(boundary_geometry(
+                j,
+                &frame,
+                &searches[j],
+                section,
+                kind,
+                parent_region,
+                child_region,
+            ));
             JointDecision {
                 name,
                 status,
@@ -389,10 +394,12 @@ fn search_all_cuts(surface: &CutSurface, bones: &BoneIndex, plans: &[JointPlan])
 /// Plane, perimeter and diameter of a boundary from `section`: the placed section of a cut,
 /// the best closed section of a soft boundary. Without one the normal is the bisector of
 /// the bones and the section a circle of the joint's surface distance r (perimeter 2πr,
-/// diameter 2r). No bone through the joint (the caller knows).
+/// diameter 2r). `search`: the joint's cut search, which says whether a bone runs through
+/// the joint.
 fn boundary_geometry(
     joint: usize,
     frame: &JointFrame,
+    search: &CutSearch,
     section: Option<&CutCandidate>,
     kind: BoundaryKind,
     parent_region: u32,
@@ -409,7 +416,7 @@ fn boundary_geometry(
         parent_region,
         child_region,
         leaf_part_past: frame.leaf_part_past,
-        bone_through: false,
+        bone_through: search.through_joint.is_some(),
     }
 }
 

@@ -85,9 +85,30 @@ impl OwnershipBones {
     }
 }
 
+impl OwnershipBones {
+    /// Whether joint `d` lies strictly below joint `c` in the skeleton.
+    pub(crate) fn strictly_below(&self, d: usize, c: usize) -> bool {
+        self.order[c] < self.order[d] && self.order[d] < self.subtree_end[c]
+    }
+}
+
+/// Test decisions: `count` joints named j0, j1, …, every one's bone in `region`.
+#[cfg(test)]
+pub(crate) fn one_region_decisions(count: usize, region: u32) -> Vec<JointDecision> {
+    (0..count)
+        .map(|k| JointDecision {
+            name: format!("j{k}"),
+            status: crate::decomposition::JointStatus::Skipped(String::new()),
+            boundary: None,
+            region: Some(region),
+            owns_skin: true,
+        })
+        .collect()
+}
+
 /// The depth-first position of every joint of `skeleton` and the end of its subtree's
 /// positions (roots in index order, children in index order).
-pub(crate) fn depth_first_ranges(skeleton: &Skeleton) -> (Vec<u32>, Vec<u32>) {
+fn depth_first_ranges(skeleton: &Skeleton) -> (Vec<u32>, Vec<u32>) {
     let children = skeleton.children();
     let (mut order, mut end) = (vec![0u32; skeleton.len()], vec![0u32; skeleton.len()]);
     let mut next = 0u32;
@@ -411,15 +432,7 @@ mod tests {
             ],
         )
         .unwrap();
-        let decisions: Vec<JointDecision> = (0..5)
-            .map(|k| JointDecision {
-                name: format!("j{k}"),
-                status: JointStatus::Skipped(String::new()),
-                boundary: None,
-                region: Some(0),
-                owns_skin: true,
-            })
-            .collect();
+        let decisions = one_region_decisions(5, 0);
         let segments = bone_segments(&skeleton);
         let bones = OwnershipBones::new(&skeleton, &decisions, &segments);
         let w = 0.05;

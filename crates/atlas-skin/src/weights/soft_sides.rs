@@ -3,7 +3,7 @@
 //! (module documentation of [`crate::weights`]).
 
 use super::blend::beta;
-use super::ownership::{depth_first_ranges, FreeBones, Ownership, OwnershipBones};
+use super::ownership::{FreeBones, Ownership, OwnershipBones};
 use crate::decomposition::{Boundary, BoundaryKind, Decomposition};
 use crate::geometry::point_segment_distance;
 use crate::overlap::Overlaps;
@@ -125,7 +125,7 @@ pub fn soft_sides(
             beyond_nearest: has_children || b.leaf_part_past,
             own_part: has_children && !b.bone_through && !bound[b.joint as usize],
         };
-        let below = |v: usize| taken.below(v, b.parent_region, b.joint);
+        let below = |v: usize| taken.below(&bones, v, b.parent_region, b.joint);
         child_side(d, b, half_width, &owner, &beyond, in_region, below, &seeds)
     };
     // The deepest joints first, those at one depth in parallel: where a joint's side takes
@@ -141,7 +141,7 @@ pub fn soft_sides(
     }
     let mut by_depth: Vec<usize> = (0..acting.len()).collect();
     by_depth.sort_by_key(|&i| std::cmp::Reverse(depth[acting[i].1.joint as usize]));
-    let mut taken = Taken::new(skeleton, d.surface.vertex_count());
+    let mut taken = Taken::new(d.surface.vertex_count());
     let mut sides: Vec<(usize, SoftSide)> = Vec::with_capacity(acting.len());
     for level in by_depth
         .chunk_by(|&a, &b| depth[acting[a].1.joint as usize] == depth[acting[b].1.joint as usize])
@@ -162,19 +162,13 @@ pub fn soft_sides(
 /// Per vertex, a soft side that takes the whole share there (s = 1), by its region and
 /// joint: the deepest recorded first ([`soft_sides`]).
 struct Taken {
-    /// #J depth-first position of every joint, and the end of its subtree's positions.
-    order: Vec<u32>,
-    subtree_end: Vec<u32>,
     /// #V (region, joint) of a side with s = 1 at the vertex.
     by: Vec<Option<(u32, u32)>>,
 }
 
 impl Taken {
-    fn new(skeleton: &Skeleton, vertex_count: usize) -> Self {
-        let (order, subtree_end) = depth_first_ranges(skeleton);
+    fn new(vertex_count: usize) -> Self {
         Self {
-            order,
-            subtree_end,
             by: vec![None; vertex_count],
         }
     }
@@ -189,12 +183,11 @@ impl Taken {
         }
     }
 
-    /// Whether a side of a joint below `joint` in `region` takes the whole share at `v`.
-    fn below(&self, v: usize, region: u32, joint: u32) -> bool {
-        self.by[v].is_some_and(|(r, d)| {
-            let (c, d) = (joint as usize, d as usize);
-            r == region && self.order[c] < self.order[d] && self.order[d] < self.subtree_end[c]
-        })
+    /// Whether a side of a joint strictly below `joint` (in the skeleton of `bones`) in
+    /// `region` takes the whole share at `v`.
+    fn below(&self, bones: &OwnershipBones, v: usize, region: u32, joint: u32) -> bool {
+        self.by[v]
+            .is_some_and(|(r, d)| r == region && bones.strictly_below(d as usize, joint as usize))
     }
 }
 
@@ -208,6 +201,7 @@ impl Taken {
 /// docs/measurements.md, "Soft joints above a continued region").
 fn continued_boundaries(d: &Decomposition, skeleton: &Skeleton) -> Vec<(usize, Boundary)> {
     let mut continued = Vec::new();
+    let mut seen = FxHashSet::default();
     for (r, region) in d.regions.iter().enumerate() {
         let r = r as u32;
         let Some((&bound, held)) = region.joints.split_first() else {
@@ -225,18 +219,14 @@ fn continued_boundaries(d: &Decomposition, skeleton: &Skeleton) -> Vec<(usize, B
                     continue;
                 };
                 let b = &d.boundaries[k];
-                if b.kind == BoundaryKind::Soft && b.diameter > 0.0 && b.parent_region != r {
+                let acts = b.kind == BoundaryKind::Soft && b.diameter > 0.0;
+                if acts && b.parent_region != r && seen.insert((k, r)) {
                     let in_region = Boundary {
                         parent_region: r,
                         child_region: r,
                         ..b.clone()
                     };
-                    if !continued
-                        .iter()
-                        .any(|(j, c): &(usize, Boundary)| *j == k && c.parent_region == r)
-                    {
-                        continued.push((k, in_region));
-                    }
+                    continued.push((k, in_region));
                 }
             }
         }
@@ -426,7 +416,9 @@ mod tests {
         let positions = [0.0, 1.0, 2.0, 3.0].map(|y| glam::Vec3::new(0.0, y, 0.0));
         let skeleton = Skeleton::from_positions(names, vec![NO_PARENT, 0, 1, 0], &positions)
             .expect("skeleton");
-        let mut taken = Taken::new(&skeleton, 2);
+        let decisions = super::super::ownership::one_region_decisions(4, 5);
+        let bones = OwnershipBones::new(&skeleton, &decisions, &bone_segments(&skeleton));
+        let mut taken = Taken::new(2);
         taken.by[0] = Some((5, 2));
         for (region, joint, below) in [
             (5, 1, true),
@@ -435,10 +427,14 @@ mod tests {
             (5, 3, false),
             (4, 1, false),
         ] {
-            assert_eq!(taken.below(0, region, joint), below, "{region} {joint}");
+            assert_eq!(
+                taken.below(&bones, 0, region, joint),
+                below,
+                "{region} {joint}"
+            );
         }
         // Nothing taken at vertex 1.
-        assert!(!taken.below(1, 5, 0));
+        assert!(!taken.below(&bones, 1, 5, 0));
     }
 
     /// The scan of the vertices finds what the grid of the vertices finds, at radii of 0, at
