@@ -90,7 +90,7 @@ pub fn render(
         "Compared with {old_name} (commit {}) → this run (commit {}):",
         old.commit, new.commit
     );
-    if old.settings != new.settings {
+    if !old.settings.same_main_poses(&new.settings) {
         let seeds = |s: &crate::bench_run::Settings| {
             format!("{} poses from seed {}", s.poses, s.first_seed)
         };
@@ -223,6 +223,26 @@ fn aggregate_lines(
         g.far_worse.len(),
         h.far_worse.len()
     );
+    for &seed in &new.settings.other_seeds {
+        if !old.settings.other_seeds.contains(&seed) {
+            continue;
+        }
+        let (g, h) = (
+            goals(table, &old.pairs_under(seed, set, table)),
+            goals(table, &new.pairs_under(seed, set, table)),
+        );
+        let _ = writeln!(
+            out,
+            "    under the poses from seed {seed}: mean lower {} → {}; max lower {} → {}; far \
+             worse {} → {}",
+            g.lower_mean_than_all,
+            h.lower_mean_than_all,
+            g.lower_max_than_all,
+            h.lower_max_than_all,
+            g.far_worse.len(),
+            h.far_worse.len()
+        );
+    }
     let fallback = |run: &BenchmarkRun| {
         let shares: Vec<f64> = run
             .of(set)
@@ -366,6 +386,8 @@ mod tests {
             "mean lower than every baseline: 1 → 2 of 3; max: 1 → 2; far worse than the better \
              baseline: 2 → 1",
             "fallback vertices, average share: 3.3% → 0.0%",
+            "under the poses from seed 10: mean lower 1 → 2; max lower 1 → 2; far worse 2 → 1",
+            "under the poses from seed 40: mean lower 1 → 2; max lower 1 → 2; far worse 2 → 1",
             "mean: 1 better, 0 worse, 1 unchanged",
             "max: 0 better, 1 worse, 1 unchanged",
             "worse (mean or max), worst first:\n    rignet-val/1.glb",
@@ -377,9 +399,16 @@ mod tests {
         }
         assert!(!text.contains("now failing"));
         assert!(!text.contains("settings differ"));
+        // A run written before the other pose sets: the main figures compare, the others
+        // are left out.
+        let mut older = old.clone();
+        older.settings.other_seeds.clear();
+        let text = render(&older, &new, &[(Set::Bench, &table)], "before.json");
+        assert!(!text.contains("settings differ"), "{text}");
+        assert!(!text.contains("under the poses from seed"), "{text}");
         // Another seed is said.
         let mut reseeded = new.clone();
-        reseeded.settings = crate::bench_run::Settings::of_eval_from(10);
+        reseeded.settings = crate::bench_run::Settings::of_eval_from(10, &[]);
         let text = render(&old, &reseeded, &[(Set::Bench, &table)], "before.json");
         assert!(
             text.contains(

@@ -6,7 +6,7 @@ use crate::bench_baselines::{BaselineTable, Figures};
 use crate::bench_characters::Set;
 use crate::bench_run::{BenchmarkRun, CharacterResult, Outcome};
 use crate::scoring::{
-    aggregate, baseline_aggregates, better_baseline, better_of_baselines, goals, Aggregate,
+    aggregate, baseline_aggregates, better_baseline, better_of_baselines, goals, Aggregate, Goals,
     FAR_WORSE_RATIO,
 };
 use crate::single_joint::SINGLE_JOINT_SHARE;
@@ -57,7 +57,7 @@ pub fn render(
              on the cores makes times noisy; use `--jobs 1` on a quiet machine for timing)"
             ))
     );
-    let whose = if *s == crate::bench_run::Settings::of_eval() {
+    let whose = if s.same_main_poses(&crate::bench_run::Settings::of_eval()) {
         "`eval`'s defaults, which are BASELINES.md's"
     } else {
         "`eval`'s defaults but the seeds (`--seed`; BASELINES.md's are 0 to 9)"
@@ -207,14 +207,6 @@ fn section(
         g.characters,
         share(g.lower_max_than_all)
     );
-    let listed: Vec<String> = g
-        .far_worse
-        .iter()
-        .map(|f| match (f.mean_ratio, f.max_ratio) {
-            (Some(mean), Some(max)) => format!("{} ({mean:.2}× / {max:.2}×)", f.name),
-            _ => format!("{} (failed)", f.name),
-        })
-        .collect();
     let _ = writeln!(
         out,
         "- worse than the better baseline by more than {:.0}% (mean or max; failures count): \
@@ -222,11 +214,7 @@ fn section(
         (FAR_WORSE_RATIO - 1.0) * 100.0,
         g.far_worse.len(),
         g.characters,
-        if listed.is_empty() {
-            String::new()
-        } else {
-            format!(": {}", listed.join(", "))
-        }
+        far_worse_list(&g)
     );
     for w in &g.wins {
         let _ = writeln!(
@@ -237,12 +225,79 @@ fn section(
         );
     }
     let _ = writeln!(out);
+    other_poses(out, run, set, table, &g);
 
     skin_report(out, set, results, &heading);
     if per_character_table {
         per_character(out, table, results);
     }
     failures(out, results);
+}
+
+/// ": name (mean ratio× / max ratio×), …" of the far-worse characters; empty without any.
+fn far_worse_list(g: &Goals) -> String {
+    let listed: Vec<String> = g
+        .far_worse
+        .iter()
+        .map(|f| match (f.mean_ratio, f.max_ratio) {
+            (Some(mean), Some(max)) => format!("{} ({mean:.2}× / {max:.2}×)", f.name),
+            _ => format!("{} (failed)", f.name),
+        })
+        .collect();
+    if listed.is_empty() {
+        String::new()
+    } else {
+        format!(": {}", listed.join(", "))
+    }
+}
+
+/// The counts of issue 13's goals under the run's other pose sets, beside those of the
+/// main set (`main`).
+fn other_poses(
+    out: &mut String,
+    run: &BenchmarkRun,
+    set: Set,
+    table: &BaselineTable,
+    main: &Goals,
+) {
+    let s = &run.settings;
+    if s.other_seeds.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        out,
+        "The same counts for the same weights under other random poses ({} poses from each \
+         first seed, as `atlas-skin eval --seed S` draws them; the baselines' rows stay \
+         BASELINES.md's). A character's max is one vertex in one pose, so the draw moves \
+         the counts by a few characters:\n",
+        s.poses
+    );
+    let _ = writeln!(
+        out,
+        "| first seed | mean lower than every baseline's | max lower than every baseline's | \
+         far worse than the better baseline |\n|---|---|---|---|"
+    );
+    let row = |out: &mut String, seed: String, g: &Goals| {
+        let _ = writeln!(
+            out,
+            "| {seed} | {} of {} | {} of {} | {}{} |",
+            g.lower_mean_than_all,
+            g.characters,
+            g.lower_max_than_all,
+            g.characters,
+            g.far_worse.len(),
+            far_worse_list(g)
+        );
+    };
+    row(out, format!("{} (above)", s.first_seed), main);
+    for &seed in &s.other_seeds {
+        row(
+            out,
+            seed.to_string(),
+            &goals(table, &run.pairs_under(seed, set, table)),
+        );
+    }
+    let _ = writeln!(out);
 }
 
 /// Fallback vertices, rigid characters, skin time (issue 12).
@@ -568,12 +623,15 @@ mod tests {
         if let Outcome::Scored(s) = &mut robot.outcome {
             s.skin.partly_read = Some("the file has 4 skinned meshes".into());
         }
-        let characters = vec![
-            scored("rignet-val/1.glb", 0.0090, 0.200, 10),
-            failed("rignet-val/2.glb"),
-            knight,
-            robot,
-        ];
+        // Under the poses from seed 10 the first character beats both baselines.
+        let mut first = scored("rignet-val/1.glb", 0.0090, 0.200, 10);
+        if let Outcome::Scored(s) = &mut first.outcome {
+            s.other_poses[0].deform = atlas_skin_eval::DeformError {
+                mean: 0.0080,
+                max: 0.110,
+            };
+        }
+        let characters = vec![first, failed("rignet-val/2.glb"), knight, robot];
         let run = run("abc1234", characters);
         let models = BaselineTable {
             tools: Vec::new(),
@@ -611,6 +669,11 @@ mod tests {
             "| robotexpressive/R.glb | 100 † | 5 | — | — | 0.0100 / 0.100, 0.500, 0.100 | — | \
              — | — | 5.0% |",
             "- rignet-val/2.glb (skin): the mesh has no triangles",
+            "| 0 (above) | 1 of 3 | 1 of 3 | 2: rignet-val/1.glb (0.97× / 1.69×), \
+             rignet-val/2.glb (failed) |",
+            "| 10 | 1 of 3 | 2 of 3 | 1: rignet-val/2.glb (failed) |",
+            "| 40 | 1 of 3 | 1 of 3 | 2: rignet-val/1.glb (0.97× / 1.69×), rignet-val/2.glb \
+             (failed) |",
         ] {
             assert!(page.contains(expected), "missing: {expected}\n\n{page}");
         }
@@ -638,8 +701,9 @@ mod tests {
             characters: Vec::new(),
         };
         let mut run = run("abc1234", vec![scored("rignet-val/1.glb", 0.01, 0.1, 0)]);
-        run.settings = crate::bench_run::Settings::of_eval_from(10);
+        run.settings = crate::bench_run::Settings::of_eval_from(10, &[]);
         let page = render(&run, &table, &models, true);
+        assert!(!page.contains("under other random poses"), "{page}");
         assert!(
             page.contains(
                 "`eval`'s defaults but the seeds (`--seed`; BASELINES.md's are 0 to 9): 10 \

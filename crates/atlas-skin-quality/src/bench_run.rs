@@ -10,7 +10,7 @@ use crate::run::{run_eval, run_skin, SkinRun};
 use crate::scoring::Pair;
 use crate::single_joint::single_joint_share;
 use anyhow::{Context, Result};
-use atlas_skin_eval::{EvalOptions, Evaluation};
+use atlas_skin_eval::{DeformError, EvalOptions, Evaluation};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -20,6 +20,11 @@ use std::time::Instant;
 /// JSON keeps: where to look first when a character gets worse.
 pub const WORST_VERTICES: usize = 3;
 
+/// The first seeds of the other pose sets every character is judged under besides the
+/// main one: issue 13's per-character goals count single vertices in single poses, and
+/// these sets show how much of a count is the draw of the poses.
+pub const OTHER_SEEDS: [u64; 4] = [10, 20, 30, 40];
+
 /// The settings `atlas-skin eval` ran with (its defaults).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Settings {
@@ -28,23 +33,45 @@ pub struct Settings {
     pub max_angle_degrees: f64,
     pub anim_frames: usize,
     pub bleeding_radius: f64,
+    /// The first seeds of the other sets of `poses` random poses under which the deform
+    /// figures are measured again (none in runs written before they were).
+    #[serde(default)]
+    pub other_seeds: Vec<u64>,
 }
 
 impl Settings {
-    /// `eval`'s defaults, which the benchmark does not override but for the first seed.
-    pub fn of_eval() -> Self {
-        Self::of_eval_from(EvalOptions::default().seed)
+    /// Whether both judge the main figures under the same poses (the other pose sets aside).
+    pub fn same_main_poses(&self, other: &Settings) -> bool {
+        let main = |s: &Settings| Settings {
+            other_seeds: Vec::new(),
+            ..s.clone()
+        };
+        main(self) == main(other)
     }
 
-    /// `eval`'s defaults with the poses' seeds from `first_seed` on.
-    pub fn of_eval_from(first_seed: u64) -> Self {
+    /// `eval`'s defaults, which the benchmark does not override but for the first seed,
+    /// and the other pose sets of [`OTHER_SEEDS`].
+    pub fn of_eval() -> Self {
+        Self::of_eval_from(EvalOptions::default().seed, &OTHER_SEEDS)
+    }
+
+    /// `eval`'s defaults with the poses' seeds from `first_seed` on, and other pose sets
+    /// from each of `other_seeds` (`first_seed` and repeats left out).
+    pub fn of_eval_from(first_seed: u64, other_seeds: &[u64]) -> Self {
         let o = EvalOptions::default();
+        let mut others = Vec::new();
+        for &seed in other_seeds {
+            if seed != first_seed && !others.contains(&seed) {
+                others.push(seed);
+            }
+        }
         Self {
             poses: o.poses,
             first_seed,
             max_angle_degrees: f64::from(o.max_angle.to_degrees()).round(),
             anim_frames: o.anim_frames,
             bleeding_radius: o.bleeding_radius,
+            other_seeds: others,
         }
     }
 }
@@ -80,6 +107,21 @@ impl BenchmarkRun {
     /// The characters of `set` that have a row in `table`, with our figures, in the
     /// table's order.
     pub fn pairs<'a>(&self, set: Set, table: &'a BaselineTable) -> Vec<Pair<'a>> {
+        self.pairs_with(set, table, CharacterResult::figures)
+    }
+
+    /// [`BenchmarkRun::pairs`] with the deform figures of the other pose set from `seed`
+    /// ([`CharacterResult::figures_under`]).
+    pub fn pairs_under<'a>(&self, seed: u64, set: Set, table: &'a BaselineTable) -> Vec<Pair<'a>> {
+        self.pairs_with(set, table, |c| c.figures_under(seed))
+    }
+
+    fn pairs_with<'a>(
+        &self,
+        set: Set,
+        table: &'a BaselineTable,
+        figures: impl Fn(&CharacterResult) -> Option<Figures>,
+    ) -> Vec<Pair<'a>> {
         table
             .characters
             .iter()
@@ -87,7 +129,7 @@ impl BenchmarkRun {
                 let ours = self.find(set, &baselines.name)?;
                 Some(Pair {
                     baselines,
-                    ours: ours.figures(),
+                    ours: figures(ours),
                 })
             })
             .collect()
@@ -110,6 +152,19 @@ impl CharacterResult {
             Outcome::Scored(s) => Some(figures_of(&s.evaluation)),
             Outcome::Failed { .. } => None,
         }
+    }
+
+    /// The figures with the deform mean and max of the pose set from `seed` (one of the
+    /// settings' `other_seeds`); `None` when the character failed or was not judged under
+    /// those poses.
+    pub fn figures_under(&self, seed: u64) -> Option<Figures> {
+        let scored = self.scored()?;
+        let other = scored.other_poses.iter().find(|o| o.first_seed == seed)?;
+        Some(Figures {
+            deform_mean: other.deform.mean,
+            deform_max: other.deform.max,
+            ..figures_of(&scored.evaluation)
+        })
     }
 
     pub fn scored(&self) -> Option<&Scored> {
@@ -144,9 +199,20 @@ pub enum Outcome {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Scored {
     pub evaluation: Evaluation,
+    /// LBS deform error under the other pose sets of the settings, in their order.
+    #[serde(default)]
+    pub other_poses: Vec<OtherPoses>,
     pub skin: SkinFacts,
-    /// Wall time of `eval`, seconds.
+    /// Wall time of `eval`, seconds (the main pose set's and the others').
     pub eval_seconds: f64,
+}
+
+/// The deform error (random poses, LBS) under the pose set whose first seed is
+/// `first_seed`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct OtherPoses {
+    pub first_seed: u64,
+    pub deform: DeformError,
 }
 
 /// What the `skin` report and the skinned file say.
@@ -213,7 +279,7 @@ pub fn run_character(
     work: &Path,
     settings: &Settings,
 ) -> CharacterResult {
-    let outcome = match score(exe, character, work, settings.first_seed) {
+    let outcome = match score(exe, character, work, settings) {
         Ok(scored) => Outcome::Scored(Box::new(scored)),
         Err((stage, error)) => Outcome::Failed {
             stage: stage.to_string(),
@@ -230,7 +296,7 @@ pub fn run_character(
 
 type Staged<T> = std::result::Result<T, (&'static str, anyhow::Error)>;
 
-fn score(exe: &Path, character: &Character, work: &Path, first_seed: u64) -> Staged<Scored> {
+fn score(exe: &Path, character: &Character, work: &Path, settings: &Settings) -> Staged<Scored> {
     let stem = work
         .join(match character.set {
             Set::Bench => "bench",
@@ -248,17 +314,31 @@ fn score(exe: &Path, character: &Character, work: &Path, first_seed: u64) -> Sta
     let run = run_skin(exe, &character.skin_args, &candidate, &report_path).map_err(skin)?;
     let facts = skin_facts(character, &run, &candidate).map_err(skin)?;
     let start = Instant::now();
-    let evaluation = run_eval(
-        exe,
-        &character.reference_args,
-        &candidate,
-        character.prune_reference,
-        WORST_VERTICES,
-        first_seed,
-    )
-    .map_err(|e| ("eval", e))?;
+    let eval = |worst, first_seed| {
+        run_eval(
+            exe,
+            &character.reference_args,
+            &candidate,
+            character.prune_reference,
+            worst,
+            first_seed,
+        )
+        .map_err(|e| ("eval", e))
+    };
+    let evaluation = eval(WORST_VERTICES, settings.first_seed)?;
+    let other_poses = settings
+        .other_seeds
+        .iter()
+        .map(|&first_seed| {
+            Ok(OtherPoses {
+                first_seed,
+                deform: eval(0, first_seed)?.deform_random,
+            })
+        })
+        .collect::<Staged<Vec<_>>>()?;
     Ok(Scored {
         evaluation,
+        other_poses,
         skin: facts,
         eval_seconds: start.elapsed().as_secs_f64(),
     })
@@ -317,7 +397,7 @@ fn skin_facts(character: &Character, run: &SkinRun, candidate: &Path) -> Result<
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use atlas_skin_eval::{Bleeding, DeformError, Validity, WeightsL1};
+    use atlas_skin_eval::{Bleeding, Validity, WeightsL1};
 
     /// A scored bench character with these deformation errors (L1 0.5, bleed 0.1, 100
     /// vertices of which `fallback` fell back, half of them bound to a single joint).
@@ -354,6 +434,10 @@ pub(crate) mod tests {
                     },
                     worst_vertices: Vec::new(),
                 },
+                other_poses: OTHER_SEEDS
+                    .iter()
+                    .map(|&first_seed| OtherPoses { first_seed, deform })
+                    .collect(),
                 skin: SkinFacts {
                     vertices: 100,
                     fallback_weighted_vertices: fallback,
@@ -404,6 +488,25 @@ pub(crate) mod tests {
             run.characters[0].scored().unwrap().skin.fallback_share(),
             0.03
         );
+        assert_eq!(
+            run.characters[0].figures_under(10),
+            run.characters[0].figures()
+        );
+        assert_eq!(run.characters[0].figures_under(11), None);
+        // A run written before the other pose sets reads, with none.
+        let mut old: serde_json::Value = serde_json::from_str(&text).unwrap();
+        old["settings"]
+            .as_object_mut()
+            .unwrap()
+            .remove("other_seeds");
+        old["characters"][0]["outcome"]
+            .as_object_mut()
+            .unwrap()
+            .remove("other_poses");
+        let old: BenchmarkRun = serde_json::from_value(old).unwrap();
+        assert!(old.settings.other_seeds.is_empty());
+        assert!(old.settings.same_main_poses(&run.settings));
+        assert_eq!(old.characters[0].figures_under(10), None);
     }
 
     #[test]
@@ -447,6 +550,13 @@ pub(crate) mod tests {
             assert_eq!(s.evaluation.matched, s.evaluation.vertices);
             assert_eq!(s.evaluation.worst_vertices.len(), WORST_VERTICES);
             assert!(s.evaluation.deform_random.mean > 0.0);
+            let seeds: Vec<u64> = s.other_poses.iter().map(|o| o.first_seed).collect();
+            assert_eq!(seeds, OTHER_SEEDS);
+            // Other poses, other figures (the same weights).
+            for other in &s.other_poses {
+                assert!(other.deform.mean > 0.0 && other.deform.max >= other.deform.mean);
+                assert_ne!(other.deform, s.evaluation.deform_random);
+            }
             assert!(s.skin.vertices > 0 && s.skin.weights_seconds.is_some());
             let artist = s.skin.reference_single_joint_share.unwrap();
             if result.rigid_by_artist == Some(true) {

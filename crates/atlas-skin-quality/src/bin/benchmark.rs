@@ -7,7 +7,7 @@
 
 use anyhow::{bail, Context, Result};
 use atlas_skin_quality::bench_characters::{bench_characters, model_characters, Set};
-use atlas_skin_quality::bench_run::{run_all, BenchmarkRun, Outcome, Settings};
+use atlas_skin_quality::bench_run::{run_all, BenchmarkRun, Outcome, Settings, OTHER_SEEDS};
 use atlas_skin_quality::{baselines, bench_baselines, bench_compare, bench_page, run};
 use clap::{Parser, ValueEnum};
 use std::path::{Path, PathBuf};
@@ -65,6 +65,12 @@ struct Args {
     /// with another writes its page under target/benchmark/ unless --out says otherwise.
     #[arg(long, default_value_t = Settings::of_eval().first_seed)]
     seed: u64,
+    /// The first seeds of other pose sets: each character's deform error is measured again
+    /// under each, and the page counts issue 13's goals for each (how much of a count is
+    /// the draw of the poses). A run with others than the default writes its page under
+    /// target/benchmark/ unless --out says otherwise.
+    #[arg(long, value_delimiter = ',', default_values_t = OTHER_SEEDS)]
+    other_seeds: Vec<u64>,
 }
 
 fn main() -> Result<()> {
@@ -111,7 +117,7 @@ fn main() -> Result<()> {
     eprintln!("{} characters on {jobs} jobs…", characters.len());
     let start = Instant::now();
     let load_at_start = load_average();
-    let settings = Settings::of_eval_from(args.seed);
+    let settings = Settings::of_eval_from(args.seed, &args.other_seeds);
     let results = run_all(
         &exe,
         &characters,
