@@ -65,7 +65,7 @@ struct Args {
     /// with another writes its page under target/benchmark/ unless --out says otherwise.
     #[arg(long, default_value_t = Settings::of_eval().first_seed)]
     seed: u64,
-    /// The first seeds of other pose sets: each character's deform error is measured again
+    /// The first seeds of other pose sets, comma-separated: each character's deform error is measured again
     /// under each, and the page counts issue 13's goals for each (how much of a count is
     /// the draw of the poses). A run with others than the default writes its page under
     /// target/benchmark/ unless --out says otherwise.
