@@ -11,6 +11,7 @@ use crate::scoring::{
 };
 use crate::single_joint::SINGLE_JOINT_SHARE;
 use crate::stats::{average, median};
+use atlas_skin_eval::{JointWeight, WorstVertex};
 use std::fmt::Write;
 
 /// The name of our rows.
@@ -75,8 +76,8 @@ pub fn render(
          so *deform* compares samples of the same distribution (on small characters the mean \
          over 10 poses moves by tens of percent with the seed). `eval` also measures DQS and \
          {} animation frames where a file has an animation, and lists each character's {} \
-         worst vertices with both weight rows (`--worst`); those are in the JSON, not in these \
-         tables.\n",
+         worst vertices with both weight rows (`--worst`); those are in the JSON, and those \
+         given to a far bone are listed after each set's goals.\n",
         s.poses,
         s.first_seed,
         s.first_seed + s.poses as u64 - 1,
@@ -226,6 +227,7 @@ fn section(
     }
     let _ = writeln!(out);
     other_poses(out, run, set, table, &g);
+    far_bone_vertices(out, results);
 
     skin_report(out, set, results, &heading);
     if per_character_table {
@@ -298,6 +300,89 @@ fn other_poses(
         );
     }
     let _ = writeln!(out);
+}
+
+/// Issue 13, item 4: a worst vertex stands out as a gross misassignment when the heaviest
+/// joint of our row has its bones at least this many times as far from it as the nearest
+/// bone, and the artist's heaviest joint is another, nearer one.
+pub const FAR_BONE_RATIO: f64 = 1.5;
+
+/// The characters whose worst vertices (`eval --worst`, kept in the JSON) include gross
+/// misassignments ([`FAR_BONE_RATIO`]), the first of them with both rows.
+fn far_bone_vertices(out: &mut String, results: &[&CharacterResult]) {
+    let mut lines = Vec::new();
+    for result in results {
+        let Some(scored) = result.scored() else {
+            continue;
+        };
+        let worst = &scored.evaluation.worst_vertices;
+        let far: Vec<(usize, &WorstVertex)> = worst
+            .iter()
+            .enumerate()
+            .filter(|(_, w)| on_far_bone(w))
+            .collect();
+        let Some(&(rank, first)) = far.first() else {
+            continue;
+        };
+        let heaviest = |row: &[JointWeight]| {
+            row.first().map_or_else(
+                || "—".to_string(),
+                |j| format!("{} {:.2} @×{:.2}", j.joint, j.weight, j.bone_distance_ratio),
+            )
+        };
+        lines.push(format!(
+            "- {}: vertex {} ({} of its {} worst, error {:.4}): ours {}; the artist's {}{}",
+            result.name,
+            first.vertex,
+            ordinal(rank + 1),
+            worst.len(),
+            first.error,
+            heaviest(&first.candidate),
+            heaviest(&first.reference),
+            match far.len() - 1 {
+                0 => String::new(),
+                more => format!(" (and {more} more of them)"),
+            }
+        ));
+    }
+    let _ = writeln!(
+        out,
+        "Worst vertices on far bones (issue 13, item 4): of each character's {} worst \
+         vertices, those whose heaviest joint in our row has its bones at least {FAR_BONE_RATIO} \
+         times as far from the vertex as the nearest bone (@×) while the artist's heaviest \
+         joint is another, nearer one: {} of {} characters{}\n",
+        crate::bench_run::WORST_VERTICES,
+        lines.len(),
+        results.len(),
+        if lines.is_empty() { "." } else { ":" }
+    );
+    if !lines.is_empty() {
+        let _ = writeln!(out, "{}\n", lines.join("\n"));
+    }
+}
+
+/// Whether our heaviest joint at `w` is a far bone and the artist's another, nearer one.
+fn on_far_bone(w: &WorstVertex) -> bool {
+    match (w.candidate.first(), w.reference.first()) {
+        (Some(ours), Some(artist)) => {
+            ours.bone_distance_ratio >= FAR_BONE_RATIO
+                && artist.joint != ours.joint
+                && artist.bone_distance_ratio < ours.bone_distance_ratio
+        }
+        _ => false,
+    }
+}
+
+/// "1st", "2nd", "3rd", "4th", ...
+fn ordinal(n: usize) -> String {
+    let suffix = match (n % 10, n % 100) {
+        (_, 11..=13) => "th",
+        (1, _) => "st",
+        (2, _) => "nd",
+        (3, _) => "rd",
+        _ => "th",
+    };
+    format!("{n}{suffix}")
 }
 
 /// Fallback vertices, rigid characters, skin time (issue 12).
@@ -631,6 +716,35 @@ mod tests {
                 max: 0.110,
             };
         }
+        // Its 2nd and 3rd worst vertices are given to a bone 2.4 times as far as the
+        // nearest one, whose joint the artist uses; its 1st is not.
+        let row = |joint: &str, weight: f32, ratio: f64| JointWeight {
+            joint: joint.into(),
+            weight,
+            bone_distance: 0.01 * ratio,
+            bone_distance_ratio: ratio,
+        };
+        let vertex = |vertex: usize, error: f64, ours: JointWeight| WorstVertex {
+            vertex,
+            position: [0.0; 3],
+            error,
+            pose: 0,
+            reference: vec![row("spine", 0.8, 1.0), row("hips", 0.2, 1.3)],
+            candidate: vec![ours],
+        };
+        if let Outcome::Scored(s) = &mut first.outcome {
+            s.evaluation.worst_vertices = vec![
+                vertex(7, 0.2, row("hips", 1.0, 1.3)),
+                vertex(9, 0.19, row("neck", 1.0, 2.4)),
+                vertex(11, 0.18, row("neck", 0.9, 2.2)),
+            ];
+        }
+        // Its heaviest joint is far, but so is the artist's, the same: not listed.
+        if let Outcome::Scored(s) = &mut knight.outcome {
+            let mut same = vertex(3, 0.1, row("spine", 1.0, 2.0));
+            same.reference = vec![row("spine", 1.0, 2.0)];
+            s.evaluation.worst_vertices = vec![same];
+        }
         let characters = vec![first, failed("rignet-val/2.glb"), knight, robot];
         let run = run("abc1234", characters);
         let models = BaselineTable {
@@ -672,6 +786,9 @@ mod tests {
             "| 0 (above) | 1 of 3 | 1 of 3 | 2: rignet-val/1.glb (0.97× / 1.69×), \
              rignet-val/2.glb (failed) |",
             "| 10 | 1 of 3 | 2 of 3 | 1: rignet-val/2.glb (failed) |",
+            "nearer one: 1 of 4 characters:\n\n- rignet-val/1.glb: vertex 9 (2nd of its 3 \
+             worst, error 0.1900): ours neck 1.00 @×2.40; the artist's spine 0.80 @×1.00 (and 1 \
+             more of them)\n",
             "| 40 | 1 of 3 | 1 of 3 | 2: rignet-val/1.glb (0.97× / 1.69×), rignet-val/2.glb \
              (failed) |",
         ] {
@@ -681,6 +798,18 @@ mod tests {
         let terminal = render(&run, &table, &models, false);
         assert!(!terminal.contains("### Per character"));
         assert!(terminal.contains("- rignet-val/2.glb (skin)"));
+    }
+
+    #[test]
+    fn ordinals() {
+        let words: Vec<String> = [1, 2, 3, 4, 11, 12, 13, 21, 22, 103]
+            .into_iter()
+            .map(ordinal)
+            .collect();
+        assert_eq!(
+            words,
+            ["1st", "2nd", "3rd", "4th", "11th", "12th", "13th", "21st", "22nd", "103rd"]
+        );
     }
 
     #[test]
