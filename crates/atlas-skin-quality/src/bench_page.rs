@@ -1,6 +1,7 @@
 //! docs/benchmark.md: the aggregate table of bench/BASELINES.md with atlas-skin's row, the
-//! goal lines of issues 12 and 13, and every character beside the baselines; then the same
-//! for the clean corpus.
+//! goal lines of issues 12 and 13 (issue 13's also under the other pose draws), the worst
+//! vertices on far bones, and every character beside the baselines; then the same for the
+//! clean corpus.
 
 use crate::bench_baselines::{BaselineTable, Figures};
 use crate::bench_characters::Set;

@@ -1,5 +1,6 @@
 //! One benchmark run: every character skinned by `atlas-skin skin --report` and judged by
-//! `atlas-skin eval --json` against the weights its file came with, in parallel; a
+//! `atlas-skin eval --json` against the weights its file came with (under the main draw of
+//! random poses and under the other draws of [`OTHER_SEEDS`]), in parallel; a
 //! character that fails gives a result saying why. The whole run serialises to JSON, the
 //! input of `--compare`.
 

@@ -1,8 +1,9 @@
 //! `benchmark`: skins every character of `shared/data/bench` and of the clean corpus with
 //! `atlas-skin skin --report`, judges each with `atlas-skin eval --json` against the artist
 //! weights in its file, in parallel, and writes docs/benchmark.md (the aggregate table of
-//! bench/BASELINES.md with atlas-skin's row, the goal lines of issues 12 and 13, every
-//! character) and the whole result as JSON. `--compare OLD.json` prints what changed
+//! bench/BASELINES.md with atlas-skin's row, the goal lines of issues 12 and 13 under each
+//! draw of poses, the worst vertices on far bones, every character) and the whole result
+//! as JSON. `--compare OLD.json` prints what changed
 //! against an earlier run. Run it through `scripts/benchmark`.
 
 use anyhow::{bail, Context, Result};
