@@ -305,11 +305,13 @@ fn other_poses(
 
 /// Issue 13, item 4: a worst vertex stands out as a gross misassignment when the heaviest
 /// joint of our row has its bones at least this many times as far from it as the nearest
-/// bone, and the artist's heaviest joint is another, nearer one.
-pub const FAR_BONE_RATIO: f64 = 1.5;
+/// bone, and the artist's heaviest joint is another, nearer one. (A listing threshold, not
+/// the weights' guard, `atlas_skin::weights::guard::FAR_BONE_RATIO`, which removes weights
+/// farther than 2.5 times the nearest bone reached through the body.)
+const LISTED_BONE_RATIO: f64 = 1.5;
 
 /// The characters whose worst vertices (`eval --worst`, kept in the JSON) include gross
-/// misassignments ([`FAR_BONE_RATIO`]), the first of them with both rows.
+/// misassignments ([`LISTED_BONE_RATIO`]), the first of them with both rows.
 fn far_bone_vertices(out: &mut String, results: &[&CharacterResult]) {
     let mut lines = Vec::new();
     for result in results {
@@ -349,7 +351,7 @@ fn far_bone_vertices(out: &mut String, results: &[&CharacterResult]) {
     let _ = writeln!(
         out,
         "Worst vertices on far bones (issue 13, item 4): of each character's {} worst \
-         vertices, those whose heaviest joint in our row has its bones at least {FAR_BONE_RATIO} \
+         vertices, those whose heaviest joint in our row has its bones at least {LISTED_BONE_RATIO} \
          times as far from the vertex as the nearest bone (@×) while the artist's heaviest \
          joint is another, nearer one: {} of {} characters{}\n",
         crate::bench_run::WORST_VERTICES,
@@ -366,7 +368,7 @@ fn far_bone_vertices(out: &mut String, results: &[&CharacterResult]) {
 fn on_far_bone(w: &WorstVertex) -> bool {
     match (w.candidate.first(), w.reference.first()) {
         (Some(ours), Some(artist)) => {
-            ours.bone_distance_ratio >= FAR_BONE_RATIO
+            ours.bone_distance_ratio >= LISTED_BONE_RATIO
                 && artist.joint != ours.joint
                 && artist.bone_distance_ratio < ours.bone_distance_ratio
         }

@@ -315,7 +315,7 @@ fn score(exe: &Path, character: &Character, work: &Path, settings: &Settings) ->
     let run = run_skin(exe, &character.skin_args, &candidate, &report_path).map_err(skin)?;
     let facts = skin_facts(character, &run, &candidate).map_err(skin)?;
     let start = Instant::now();
-    let eval = |worst, first_seed| {
+    let eval = |worst, first_seed, animation| {
         run_eval(
             exe,
             &character.reference_args,
@@ -323,17 +323,19 @@ fn score(exe: &Path, character: &Character, work: &Path, settings: &Settings) ->
             character.prune_reference,
             worst,
             first_seed,
+            animation,
         )
         .map_err(|e| ("eval", e))
     };
-    let evaluation = eval(WORST_VERTICES, settings.first_seed)?;
+    let evaluation = eval(WORST_VERTICES, settings.first_seed, true)?;
+    // Only the random poses' figures differ between draws.
     let other_poses = settings
         .other_seeds
         .iter()
         .map(|&first_seed| {
             Ok(OtherPoses {
                 first_seed,
-                deform: eval(0, first_seed)?.deform_random,
+                deform: eval(0, first_seed, false)?.deform_random,
             })
         })
         .collect::<Staged<Vec<_>>>()?;

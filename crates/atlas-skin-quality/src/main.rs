@@ -116,6 +116,7 @@ fn run_eval(exe: &Path, model: &Model, models_dir: &Path, candidate: &Path) -> R
         model.prune_reference,
         0,
         atlas_skin_eval::EvalOptions::default().seed,
+        true,
     )
 }
 

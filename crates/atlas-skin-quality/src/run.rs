@@ -149,8 +149,10 @@ pub fn run_skin(
 }
 
 /// `atlas-skin eval REFERENCE_ARGS CANDIDATE --json --worst WORST --seed FIRST_SEED
-/// [--prune-reference N]`, with `eval`'s other default settings (those of BASELINES.md: 10
-/// random poses, from seed 0 there, up to 60° per joint, LBS and DQS, 8 animation frames).
+/// [--prune-reference N] [--anim-frames 0]`, with `eval`'s other default settings (those of
+/// BASELINES.md: 10 random poses, from seed 0 there, up to 60° per joint, LBS and DQS, 8
+/// animation frames unless `animation` is false: the animation's figures do not depend on
+/// the seed).
 pub fn run_eval(
     exe: &Path,
     reference_args: &[OsString],
@@ -158,6 +160,7 @@ pub fn run_eval(
     prune_reference: Option<u16>,
     worst: usize,
     first_seed: u64,
+    animation: bool,
 ) -> Result<Evaluation> {
     let mut args: Vec<OsString> = vec!["eval".into()];
     args.extend_from_slice(reference_args);
@@ -171,6 +174,9 @@ pub fn run_eval(
     ]);
     if let Some(n) = prune_reference {
         args.extend(["--prune-reference".into(), n.to_string().into()]);
+    }
+    if !animation {
+        args.extend(["--anim-frames".into(), "0".into()]);
     }
     let stdout = run_process(exe, &args, PROCESS_TIMEOUT)?;
     serde_json::from_slice(&stdout).context("atlas-skin eval --json printed unexpected JSON")
