@@ -189,3 +189,93 @@ fn eval_takes_a_blender_bone_heat_export_as_it_takes_one_with_matching_names() {
     let max = with_blender_names["deform_random"]["max"].as_f64().unwrap();
     assert!(max > 1e-3 && max < 0.5, "{max}");
 }
+
+/// `scripts/heat-same-poses` on a benchmark run of two characters: Blender's bone heat
+/// weighs one (and reproduces BASELINES.md's heat mean there) and fails on the other, as it
+/// does in BASELINES.md; the page judges the first under every draw of the run.
+#[test]
+fn heat_same_poses_judges_bone_heat_under_the_runs_own_draws() {
+    let dir = out_dir("heat-same-poses");
+    let benchmark = Path::new(env!("CARGO_BIN_EXE_atlas-skin")).with_file_name("benchmark");
+    assert!(
+        benchmark.is_file(),
+        "{} is missing: cargo build --release -p atlas-skin-quality",
+        benchmark.display()
+    );
+    let run = dir.join("run.json");
+    let output = Command::new(&benchmark)
+        .args(["--character", "rignet-val/8190.glb"])
+        .args(["--character", "rignet-val/1168.glb"])
+        .arg("--json")
+        .arg(&run)
+        .arg("--out")
+        .arg(dir.join("benchmark.md"))
+        .arg("--work")
+        .arg(dir.join("benchmark"))
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let script = workspace().join("scripts/heat-same-poses");
+    let page = dir.join("page.md");
+    let heat = |extra: &[&str]| {
+        Command::new(&script)
+            .arg("--benchmark")
+            .arg(&run)
+            .arg("--out")
+            .arg(&page)
+            .arg("--work")
+            .arg(dir.join("heat"))
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let output = heat(&[]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let text = std::fs::read_to_string(&page).unwrap();
+    let seeds = [0, 10, 20, 30, 40];
+    for seed in seeds {
+        assert!(
+            text.contains(&format!("| {seed} | 1 of 1 | ")),
+            "no row for the draw from seed {seed}:\n{text}"
+        );
+    }
+    assert!(
+        text.contains("| rignet-val/1168.glb | failed | failed |"),
+        "{text}"
+    );
+    let figures: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("heat/heat.json")).unwrap())
+            .unwrap();
+    let scored = figures["characters"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["name"] == "rignet-val/8190.glb")
+        .unwrap();
+    for seed in seeds {
+        let deform = &scored["heat"][seed.to_string()];
+        let (mean, max) = (
+            deform["mean"].as_f64().unwrap(),
+            deform["max"].as_f64().unwrap(),
+        );
+        assert!(mean > 0.0 && max > mean, "seed {seed}: {deform}");
+    }
+    // BASELINES.md's heat row of 8190: deform mean .0026 under its own draw.
+    let mean = scored["heat"]["0"]["mean"].as_f64().unwrap();
+    assert!((mean / 0.0026 - 1.0).abs() < 0.25, "{mean}");
+    // A character the run did not score is named, and the page is left as it was.
+    let before = std::fs::read_to_string(&page).unwrap();
+    let output = heat(&["--character", "rignet-val/426.glb"]);
+    assert!(!output.status.success());
+    let message = String::from_utf8_lossy(&output.stderr);
+    assert!(message.contains("rignet-val/426.glb"), "{message}");
+    assert_eq!(std::fs::read_to_string(&page).unwrap(), before);
+}
