@@ -1,5 +1,5 @@
-//! The layout tables of the documentation match the tree: the README's table of crates
-//! lists every crate of `crates/` and nothing else, and docs/method.md's table of the
+//! The layout tables of the documentation match the tree: the tables of crates in README.md
+//! and docs/README.md list every crate of `crates/` and nothing else, and docs/method.md's table of the
 //! method crate's folders lists every top-level module of `crates/atlas-skin/src` and
 //! nothing else (the order of that table is checked against the imports by
 //! `module_cycles.rs`, through `lib.rs`'s table).
@@ -41,23 +41,27 @@ fn quoted(cell: &str) -> Vec<String> {
 }
 
 #[test]
-fn the_readme_lists_every_crate() {
+fn the_readmes_list_every_crate() {
     let root = repository();
-    let listed: BTreeSet<String> =
-        first_column_after(&read(&root.join("README.md")), "## Layout")
-            .iter()
-            .flat_map(|cell| quoted(cell))
-            .collect();
     let crates: BTreeSet<String> = std::fs::read_dir(root.join("crates"))
         .unwrap()
         .map(|entry| entry.unwrap().path())
         .filter(|dir| dir.join("Cargo.toml").is_file())
         .map(|dir| format!("crates/{}", dir.file_name().unwrap().to_string_lossy()))
         .collect();
-    assert_eq!(
-        listed, crates,
-        "README.md's Layout table against the crates of crates/"
-    );
+    for (file, heading) in [
+        ("README.md", "## Layout"),
+        ("docs/README.md", "## The repository"),
+    ] {
+        let listed: BTreeSet<String> = first_column_after(&read(&root.join(file)), heading)
+            .iter()
+            .flat_map(|cell| quoted(cell))
+            .collect();
+        assert_eq!(
+            listed, crates,
+            "{file}'s table under `{heading}` against the crates of crates/"
+        );
+    }
 }
 
 #[test]
