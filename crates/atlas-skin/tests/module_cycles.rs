@@ -642,7 +642,12 @@ fn lib_table_rows(lib: &Path) -> Vec<Vec<String>> {
         .filter_map(|line| line.strip_prefix("//! |"))
         .skip(2) // the header and its separator
         .map(|row| {
-            let last = row.trim_end().trim_end_matches('|').rsplit('|').next().unwrap();
+            let last = row
+                .trim_end()
+                .trim_end_matches('|')
+                .rsplit('|')
+                .next()
+                .unwrap();
             last.split("[`")
                 .skip(1)
                 .map(|link| {
@@ -672,14 +677,19 @@ fn the_lib_table_lists_every_module_in_import_order() {
         .iter()
         .filter(|m| !row_of.contains_key(m.as_str()))
         .collect();
-    assert!(missing.is_empty(), "lib.rs's table does not list {missing:?}");
-    let unknown: Vec<&&str> = row_of
-        .keys()
-        .filter(|n| !modules.contains(**n))
-        .collect();
-    assert!(unknown.is_empty(), "lib.rs's table lists no module {unknown:?}");
+    assert!(
+        missing.is_empty(),
+        "lib.rs's table does not list {missing:?}"
+    );
+    let unknown: Vec<&&str> = row_of.keys().filter(|n| !modules.contains(**n)).collect();
+    assert!(
+        unknown.is_empty(),
+        "lib.rs's table lists no module {unknown:?}"
+    );
     let mut upward = String::new();
-    let edges = sibling_edges(&krate).remove(&Vec::new()).unwrap_or_default();
+    let edges = sibling_edges(&krate)
+        .remove(&Vec::new())
+        .unwrap_or_default();
     for ((from, to), edge) in &edges {
         if row_of[to.as_str()] > row_of[from.as_str()] {
             let r = &edge.reference;
