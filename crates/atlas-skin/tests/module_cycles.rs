@@ -355,14 +355,6 @@ impl<'ast> Visit<'ast> for Collector<'_> {
         }
     }
 
-    fn visit_stmt(&mut self, stmt: &'ast syn::Stmt) {
-        if let syn::Stmt::Item(item) = stmt {
-            self.visit_item(item);
-        } else {
-            syn::visit::visit_stmt(self, stmt);
-        }
-    }
-
     fn visit_item_use(&mut self, item: &'ast syn::ItemUse) {
         let line = item.use_token.span.start().line;
         self.use_tree(&mut Vec::new(), &item.tree, line);
