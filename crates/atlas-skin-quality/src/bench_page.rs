@@ -87,6 +87,7 @@ pub fn render(
         s.anim_frames,
         crate::bench_run::WORST_VERTICES
     );
+    out.push_str(&crate::group_scores::render(run));
     let bench_results = run.of(Set::Bench);
     if !bench_results.is_empty() {
         section(
@@ -129,8 +130,8 @@ fn section(
 ) {
     let pairs = run.pairs(set, table);
     let heading = |title: &str| match set {
-        Set::Bench => format!("## {title}\n"),
         Set::Models => format!("## {title} (corpus)\n"),
+        _ => format!("## {title}\n"),
     };
     let _ = writeln!(out, "{}", heading("Aggregate"));
     let _ = writeln!(
@@ -490,11 +491,11 @@ fn skin_report(
              {:.1} ms, slowest {:.1} ms (parallel jobs share the cores)",
             median(&times).unwrap_or(0.0),
             match set {
-                Set::Bench => format!(
+                Set::Models => String::new(),
+                _ => format!(
                     "; under {SKIN_MS:.0} ms on {under} of {} (issue 12's goal: all)",
                     times.len()
                 ),
-                Set::Models => String::new(),
             },
             median(&command_ms).unwrap_or(0.0),
             command_ms.iter().copied().fold(0.0, f64::max)
