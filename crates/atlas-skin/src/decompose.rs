@@ -79,6 +79,7 @@ pub fn decompose(
         &plans,
         &searches,
         params.snap_fraction,
+        &params.rules_off,
     );
 
     let curves: Vec<_> = placements

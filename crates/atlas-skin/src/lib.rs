@@ -15,6 +15,7 @@
 //! | what the report shows of a decomposition | | [`report`] |
 //! | shapes with known answers and the demo character | | [`fixtures`] |
 
+pub mod ablation;
 pub mod cuts;
 pub mod decompose;
 pub mod decomposition;

@@ -11,6 +11,7 @@
 //! Inputs: a [`SkinInput`] (stored positions and triangles, the skeleton in the mesh's bind
 //! space, the joints the input marks as end points) and [`SkinParams`]. Output: [`Skinned`].
 
+use crate::ablation::RulesOff;
 use crate::decompose::{decompose, DecomposeError, DecomposeParams};
 use crate::decomposition::Decomposition;
 use crate::mesh::duplicate_faces::remove_duplicate_faces;
@@ -73,6 +74,9 @@ pub struct SkinParams {
     pub blend: Blend,
     /// Influences kept per stored vertex, the largest, renormalised (at least 1).
     pub max_influences: usize,
+    /// §4–5: rules of the weights stage switched off, to measure each alone (a developer
+    /// setting: [`crate::ablation`]).
+    pub weights_rules_off: RulesOff,
 }
 
 impl Default for SkinParams {
@@ -82,6 +86,7 @@ impl Default for SkinParams {
             overlap: OverlapParams::default(),
             blend: Blend::default(),
             max_influences: 4,
+            weights_rules_off: RulesOff::default(),
         }
     }
 }
@@ -252,8 +257,13 @@ pub fn skin(
     done(&mut timings);
 
     let done = run(Stage::Weights);
-    let (surface_weights, weight_counts) =
-        compute_weights(&decomposition, &skeleton, &overlaps, params.blend)?;
+    let (surface_weights, weight_counts) = compute_weights(
+        &decomposition,
+        &skeleton,
+        &overlaps,
+        params.blend,
+        &params.weights_rules_off,
+    )?;
     if !weight_counts.twins_given_a_share.is_empty() {
         warnings.push(format!(
             "{} joint(s) sit at the point of a joint that has weight and got none of their \

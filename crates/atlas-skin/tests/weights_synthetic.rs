@@ -185,8 +185,14 @@ fn decompose_by_hand(
 fn weights_of(decomposition: &Decomposition, skeleton: &Skeleton, blend: Blend) -> SurfaceWeights {
     let overlaps =
         compute_overlaps(decomposition, skeleton, &OverlapParams::default()).expect("overlaps");
-    let (weights, counts) =
-        compute_weights(decomposition, skeleton, &overlaps, blend).expect("weights");
+    let (weights, counts) = compute_weights(
+        decomposition,
+        skeleton,
+        &overlaps,
+        blend,
+        &Default::default(),
+    )
+    .expect("weights");
     assert_eq!(counts.unreachable, 0);
     weights
 }
@@ -562,6 +568,7 @@ fn a_gap_of_a_decomposed_piece_is_weighted_as_a_whole() {
         &skeleton,
         &overlaps,
         Blend::PartitionOfUnity,
+        &Default::default(),
     )
     .expect("weights");
     assert_partition_of_unity(&weights);

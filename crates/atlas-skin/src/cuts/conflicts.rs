@@ -31,6 +31,7 @@
 use super::joint_roles::{JointFrame, JointPlan};
 use super::plane_search::{CutCandidate, CutSearch};
 use super::plane_section::{Chord, CrossingPoint, SectionCurve};
+use crate::ablation::{Rule, RulesOff};
 use crate::mesh::{SurfaceMesh, Topology};
 use atlas_skin_runtime::{Skeleton, NO_PARENT};
 use std::collections::HashMap;
@@ -74,16 +75,23 @@ pub fn place_cuts(
     plans: &[JointPlan],
     searches: &[CutSearch],
     gap: f64,
+    rules_off: &RulesOff,
 ) -> Vec<Placement> {
     let candidates: Vec<&[CutCandidate]> = searches.iter().map(|s| &s.candidates[..]).collect();
-    let order = placement_order(plans, &candidates, &skeleton.parents);
+    let order = placement_order(
+        plans,
+        &candidates,
+        &skeleton.parents,
+        rules_off.on(Rule::WideSections),
+    );
+    let twins_alike = rules_off.on(Rule::MirrorTwins);
     // Joints denied a cut because their mirror twin gets none. The set only grows, so the
     // passes end; each pass places the others again without the denied joints' cuts.
     let mut denied: Vec<Option<u32>> = vec![None; plans.len()];
     let placed = loop {
         let placed = place_in_order(mesh, topology, &order, &candidates, &denied, gap);
         let mut grew = false;
-        for (j, plan) in plans.iter().enumerate() {
+        for (j, plan) in plans.iter().enumerate().filter(|_| twins_alike) {
             let Some(twin) = mirror_twin(plan) else {
                 continue;
             };
@@ -205,10 +213,12 @@ fn placement_order(
     plans: &[JointPlan],
     candidates: &[&[CutCandidate]],
     parents: &[u32],
+    wide_sections_last: bool,
 ) -> Vec<usize> {
     let best_perimeter = |j: usize| candidates[j].first().map(|c| c.perimeter);
     let group = |j: usize| {
-        let wider_than_parent = parents[j] != NO_PARENT
+        let wider_than_parent = wide_sections_last
+            && parents[j] != NO_PARENT
             && best_perimeter(parents[j] as usize)
                 .zip(best_perimeter(j))
                 .is_some_and(|(parent, own)| own > WIDE_SECTION_RATIO * parent);
@@ -369,7 +379,7 @@ mod tests {
             .chain(perimeters.iter().map(|&p| vec![candidate(p)]))
             .collect();
         let candidates: Vec<&[CutCandidate]> = candidates.iter().map(|c| &c[..]).collect();
-        placement_order(&plans, &candidates, &parents)
+        placement_order(&plans, &candidates, &parents, true)
     }
 
     #[test]
@@ -463,7 +473,15 @@ mod tests {
             })
         };
         let plans = [JointPlan::Skip("root".into()), twin_of(2), twin_of(1)];
-        place_cuts(&mesh, &topology, &skeleton, &plans, &searches, 0.01)
+        place_cuts(
+            &mesh,
+            &topology,
+            &skeleton,
+            &plans,
+            &searches,
+            0.01,
+            &RulesOff::default(),
+        )
     }
 
     #[test]

@@ -84,6 +84,7 @@
 //! bone length, that maps the joint set best onto itself.
 
 use super::params::{DecomposeParams, Override};
+use crate::ablation::Rule;
 use crate::geometry::point_segment_distance;
 use crate::mesh::spatial_index::FaceSpheres;
 use crate::mesh::SurfaceMesh;
@@ -279,7 +280,13 @@ impl Rig<'_> {
             _ => {}
         }
         if self.skeleton.parent(j).is_none() && !forced {
-            if let Some(child) = self.motion_root_child(j) {
+            let motion_root = self
+                .params
+                .rules_off
+                .on(Rule::MotionRoots)
+                .then(|| self.motion_root_child(j))
+                .flatten();
+            if let Some(child) = motion_root {
                 return JointPlan::Exclude(format!(
                     "motion root: outside the mesh, its one child {} inside it",
                     self.skeleton.names[child]
@@ -304,7 +311,7 @@ impl Rig<'_> {
                 bones.longest_bone
             ));
         }
-        if frame.on_mirror_plane {
+        if frame.on_mirror_plane && self.params.rules_off.on(Rule::MirrorBranching) {
             if let Some(plan) = branching_plan(&frame, &bones.child_vectors) {
                 return plan;
             }
@@ -322,14 +329,18 @@ impl Rig<'_> {
                 self.params.leaf_extent_ratio,
             ) {
                 LeafPart::Owned => {}
-                LeafPart::PastBone => frame.leaf_part_past = true,
-                LeafPart::OffAxis => {
+                LeafPart::PastBone if self.params.rules_off.on(Rule::LeafPartPast) => {
+                    frame.leaf_part_past = true
+                }
+                LeafPart::OffAxis if self.params.rules_off.on(Rule::LeafOffAxis) => {
                     return JointPlan::CutOrSkip(
                         frame,
                         format!("{end_site} along its bone, and no closed cut fits beside it"),
                     )
                 }
-                LeafPart::None => return JointPlan::Skip(end_site.into()),
+                LeafPart::None | LeafPart::PastBone | LeafPart::OffAxis => {
+                    return JointPlan::Skip(end_site.into())
+                }
             }
         }
         JointPlan::Boundary(frame)
@@ -383,9 +394,15 @@ impl Rig<'_> {
         };
         let own_axis = self
             .bone_axis
-            .filter(|_| child_vectors.is_empty())
+            .filter(|_| child_vectors.is_empty() && self.params.rules_off.on(Rule::LeafBoneAxis))
             .and_then(|axis| axis.direction(self.skeleton, j));
-        let lower = own_axis.unwrap_or_else(|| lower_direction(upper, &child_vectors));
+        let lower = own_axis.unwrap_or_else(|| {
+            lower_direction(
+                upper,
+                &child_vectors,
+                self.params.rules_off.on(Rule::SpreadChildren),
+            )
+        });
         if upper == DVec3::ZERO {
             return None;
         }
@@ -421,13 +438,13 @@ impl Rig<'_> {
 /// The lower bone's unit direction of a joint with upper bone `upper` and bones
 /// `child_vectors` to its children (rule 7): the mean m̂ of the children's unit directions,
 /// or `upper` when there are none or when they spread and fold back.
-fn lower_direction(upper: DVec3, child_vectors: &[DVec3]) -> DVec3 {
+fn lower_direction(upper: DVec3, child_vectors: &[DVec3], spread_rule: bool) -> DVec3 {
     let sum: DVec3 = child_vectors.iter().map(|v| v.normalize()).sum();
     let Some(mean) = sum.try_normalize() else {
         return upper;
     };
     let spread = sum.length() < SPREAD_MEAN_LENGTH * child_vectors.len() as f64;
-    if child_vectors.len() >= 2 && spread && upper.dot(mean) < -FOLD_BACK_COSINE {
+    if spread_rule && child_vectors.len() >= 2 && spread && upper.dot(mean) < -FOLD_BACK_COSINE {
         upper
     } else {
         mean
@@ -969,32 +986,35 @@ mod tests {
             DVec3::new(0.043, 0.011, -0.026),
             DVec3::new(-0.044, 0.011, -0.026),
         ];
-        assert_eq!(lower_direction(waist_to_pelvis, &thighs), waist_to_pelvis);
+        assert_eq!(
+            lower_direction(waist_to_pelvis, &thighs, true),
+            waist_to_pelvis
+        );
         // Reached straight from above, the remainder turns less than 120° from the upper
         // bone: kept.
-        assert!(lower_direction(down, &thighs).y > 0.0);
+        assert!(lower_direction(down, &thighs, true).y > 0.0);
         // The same thighs below a pelvis reached from above at a slant keep their mean
         // where it does not turn back.
         let level = [DVec3::new(0.04, -0.01, 0.0), DVec3::new(-0.04, -0.01, 0.0)];
-        assert_eq!(lower_direction(down, &level), DVec3::NEG_Y);
+        assert_eq!(lower_direction(down, &level, true), DVec3::NEG_Y);
         // A chest: neck up, arms to both sides; the mean points on along the spine.
         let up = DVec3::Y;
         let chest = [DVec3::Y, DVec3::X, DVec3::NEG_X];
-        assert!(lower_direction(up, &chest).abs_diff_eq(up, 1e-12));
+        assert!(lower_direction(up, &chest, true).abs_diff_eq(up, 1e-12));
         // A wrist: fingers spread a little; the mean finger direction.
         let fingers = [
             unit(1.0, 0.2, 0.0),
             unit(1.0, 0.0, 0.0),
             unit(1.0, -0.2, 0.0),
         ];
-        assert!(lower_direction(DVec3::X, &fingers).abs_diff_eq(DVec3::X, 1e-12));
+        assert!(lower_direction(DVec3::X, &fingers, true).abs_diff_eq(DVec3::X, 1e-12));
         // One child folding back at a sharp bend keeps its own direction (the mitre).
         let folded = [DVec3::new(0.2, 1.0, 0.0)];
-        assert!(lower_direction(down, &folded).abs_diff_eq(folded[0].normalize(), 1e-12));
+        assert!(lower_direction(down, &folded, true).abs_diff_eq(folded[0].normalize(), 1e-12));
         // Two children folding back together (not spread) keep their mean.
         let tails = [unit(0.1, 1.0, 0.0), unit(-0.1, 1.0, 0.0)];
-        assert!(lower_direction(down, &tails).abs_diff_eq(up, 1e-12));
+        assert!(lower_direction(down, &tails, true).abs_diff_eq(up, 1e-12));
         // No children: the upper bone.
-        assert_eq!(lower_direction(down, &[]), down);
+        assert_eq!(lower_direction(down, &[], true), down);
     }
 }

@@ -97,6 +97,7 @@ pub mod soft_sides;
 pub mod surface_weights;
 pub mod twins;
 
+use crate::ablation::{Rule, RulesOff};
 use crate::decomposition::{BoundaryKind, Decomposition};
 use crate::overlap::Overlaps;
 use crate::skeleton::bones::{bone_segments, JointBones};
@@ -142,30 +143,45 @@ pub enum WeightsError {
 ///
 /// - `skeleton`: the decomposed skeleton (#J joints, one decision each).
 /// - `overlaps`: from [`crate::overlap::compute_overlaps`] on the same decomposition.
+///
+/// - `rules_off`: rules of this stage switched off ([`crate::ablation`]; none by default).
 pub fn compute_weights(
     decomposition: &Decomposition,
     skeleton: &Skeleton,
     overlaps: &Overlaps,
     blend: Blend,
+    rules_off: &RulesOff,
 ) -> Result<(SurfaceWeights, WeightCounts), WeightsError> {
     let RegionWeights {
         mut weights,
         leaf_patches,
         inactive_soft_joints,
-    } = region_weights(decomposition, skeleton, overlaps, blend)?;
+    } = region_weights_with(decomposition, skeleton, overlaps, blend, rules_off)?;
     let owns_skin: Vec<bool> = decomposition.joints.iter().map(|d| d.owns_skin).collect();
     let joint_bones = JointBones::new(&bone_segments(skeleton));
-    let sibling_blend_vertices = merge_sibling_blends(
-        skeleton,
-        &decomposition.surface.positions,
-        &joint_bones,
-        &owns_skin,
-        &leaf_patches,
-        &mut weights,
-    );
-    let far_bone_vertices = guard_far_bones(decomposition, skeleton, &joint_bones, &mut weights);
+    let sibling_blend_vertices = if rules_off.on(Rule::SiblingBlends) {
+        merge_sibling_blends(
+            skeleton,
+            &decomposition.surface.positions,
+            &joint_bones,
+            &owns_skin,
+            &leaf_patches,
+            &mut weights,
+        )
+    } else {
+        0
+    };
+    let far_bone_vertices = if rules_off.on(Rule::FarBoneGuard) {
+        guard_far_bones(decomposition, skeleton, &joint_bones, &mut weights)
+    } else {
+        0
+    };
     let mut counts = weight_pieces(decomposition, skeleton, overlaps, &mut weights);
-    let twins = share_among_twins(skeleton, &owns_skin, &mut weights);
+    let twins = if rules_off.on(Rule::TwinShares) {
+        share_among_twins(skeleton, &owns_skin, &mut weights)
+    } else {
+        Default::default()
+    };
     counts.twins_given_a_share = twins.given;
     counts.twins_too_many_to_share = twins.too_many;
     counts.far_bone_vertices = far_bone_vertices;
@@ -185,12 +201,29 @@ pub struct RegionWeights {
     pub inactive_soft_joints: Vec<u32>,
 }
 
-/// Steps 1–3 alone (module documentation), with the arguments of [`compute_weights`].
+/// Steps 1–3 alone (module documentation), with the arguments of [`compute_weights`] and
+/// every rule on.
 pub fn region_weights(
     decomposition: &Decomposition,
     skeleton: &Skeleton,
     overlaps: &Overlaps,
     blend: Blend,
+) -> Result<RegionWeights, WeightsError> {
+    region_weights_with(
+        decomposition,
+        skeleton,
+        overlaps,
+        blend,
+        &RulesOff::default(),
+    )
+}
+
+fn region_weights_with(
+    decomposition: &Decomposition,
+    skeleton: &Skeleton,
+    overlaps: &Overlaps,
+    blend: Blend,
+    rules_off: &RulesOff,
 ) -> Result<RegionWeights, WeightsError> {
     validate(decomposition, skeleton, overlaps)?;
     let vertex_count = decomposition.surface.vertex_count();
@@ -212,7 +245,11 @@ pub fn region_weights(
             })
         })
         .collect();
-    let patches = leaf_patches(decomposition, skeleton, &active, &region_vertices);
+    let patches = if rules_off.on(Rule::LeafPatches) {
+        leaf_patches(decomposition, skeleton, &active, &region_vertices)
+    } else {
+        Vec::new()
+    };
     let trees = region_trees(decomposition, skeleton, &softs);
     let weights = blend_vertices(decomposition, &related, &softs, &patches, &trees, blend);
     Ok(RegionWeights {
