@@ -570,6 +570,18 @@ pub(crate) mod tests {
                 assert_ne!(other.deform, s.evaluation.deform_random);
             }
             assert!(s.skin.vertices > 0 && s.skin.weights_seconds.is_some());
+            let rignet = s.evaluation.rignet.expect("RigNet's metrics");
+            assert!(rignet.vertices > 0 && (0.0..=1.0).contains(&rignet.precision));
+            assert!((0.0..=1.0).contains(&rignet.recall) && rignet.l1 >= 0.0);
+            // Nearest bone is computed here, under the same poses; bone heat only where
+            // scripts/bone-heat has run (not in this fresh folder).
+            let nearest = result
+                .baselines
+                .scored(crate::computed_baselines::Baseline::NearestBone)
+                .unwrap_or_else(|| panic!("no nearest-bone figures: {:?}", result.baselines));
+            assert!(nearest.deform.mean > 0.0 && nearest.other_poses.len() == OTHER_SEEDS.len());
+            assert_eq!(nearest.rignet.map(|r| r.vertices), Some(rignet.vertices));
+            assert_eq!(result.baselines.bone_heat, None);
             let artist = s.skin.reference_single_joint_share.unwrap();
             if result.rigid_by_artist == Some(true) {
                 assert_eq!(artist, 1.0, "{}", result.name);

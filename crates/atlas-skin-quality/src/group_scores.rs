@@ -442,3 +442,58 @@ pub fn summary_line(g: &GroupScores) -> String {
         g.far_worse.len()
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bench_characters::Set;
+    use crate::bench_run::tests::{failed, run, scored};
+    use crate::computed_baselines::{BaselineFigures, BaselineOutcome, Baselines};
+    use atlas_skin_eval::DeformError;
+
+    fn with_nearest(mut c: CharacterResult, set: Set, mean: f64, max: f64) -> CharacterResult {
+        c.set = set;
+        c.baselines = Baselines {
+            nearest_bone: Some(BaselineOutcome::Scored(BaselineFigures {
+                deform: DeformError { mean, max },
+                other_poses: Vec::new(),
+                weights_l1: 0.9,
+                rignet: None,
+            })),
+            bone_heat: Some(BaselineOutcome::Failed {
+                reason: "failed to find a solution".into(),
+            }),
+        };
+        c
+    }
+
+    #[test]
+    fn groups_average_their_characters_and_count_the_far_worse() {
+        let run = run(
+            "abc",
+            vec![
+                // Tune: one at half nearest bone's max, one at twice (far worse).
+                with_nearest(scored("a.glb", 0.01, 0.1, 0), Set::Train, 0.02, 0.2),
+                with_nearest(scored("b.glb", 0.03, 0.4, 0), Set::Bench, 0.02, 0.2),
+                // Check: a failure is far worse.
+                with_nearest(failed("c.glb"), Set::Check, 0.02, 0.2),
+                with_nearest(scored("d.glb", 0.01, 0.2, 0), Set::Check, 0.02, 0.4),
+            ],
+        );
+        let tune = group_scores(&run, Group::Tune).unwrap();
+        assert_eq!((tune.characters, tune.failed, tune.heat_failed), (2, 0, 2));
+        assert_eq!(tune.far_worse, ["b.glb"]);
+        let (mean, max) = tune.ratios_to_nearest().unwrap();
+        assert!((mean - 1.0).abs() < 1e-12 && (max - 1.25).abs() < 1e-12);
+        assert_eq!(tune.ratios_to_heat(), None);
+        let check = group_scores(&run, Group::Check).unwrap();
+        assert_eq!((check.characters, check.failed), (2, 1));
+        assert_eq!(check.far_worse, ["c.glb"]);
+        assert!((check.far_worse_share() - 0.5).abs() < 1e-12);
+        assert_eq!(group_scores(&run, Group::Corpus), None);
+        let page = render(&run);
+        assert!(page.contains("| | tune (2) | check (2) |"), "{page}");
+        assert!(page.contains("far worse ≤ 3%: 50.0% (**not met**)"), "{page}");
+        assert!(page.contains("MagicArticulate"), "{page}");
+    }
+}

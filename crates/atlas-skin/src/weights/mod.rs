@@ -176,7 +176,7 @@ pub fn compute_weights(
     } else {
         0
     };
-    let mut counts = weight_pieces(decomposition, skeleton, overlaps, &mut weights);
+    let mut counts = weight_pieces(decomposition, skeleton, overlaps, &mut weights, rules_off);
     let twins = if rules_off.on(Rule::TwinShares) {
         share_among_twins(skeleton, &owns_skin, &mut weights)
     } else {
@@ -230,7 +230,7 @@ fn region_weights_with(
     let bands = vertex_bands(&overlaps.bands, vertex_count);
     let related = related_regions(decomposition, overlaps, &bands);
     let region_vertices = region_vertices(decomposition, &related);
-    let softs = soft_sides(decomposition, skeleton, overlaps, &related);
+    let softs = soft_sides(decomposition, skeleton, overlaps, &related, rules_off);
     let mut has_soft_side = vec![false; skeleton.len()];
     for s in &softs {
         has_soft_side[s.joint as usize] = true;
