@@ -10,6 +10,7 @@ mod errors;
 use crate::errors::{no_panic, to_py_err};
 use atlas_skin::pipeline::{skin, SkinInput};
 use atlas_skin::weights::blend::Blend;
+use atlas_skin::weights::rigid::Binding;
 use atlas_skin_io::gltf::MAX_INFLUENCES;
 use atlas_skin_io::{Character, LoadOptions};
 use atlas_skin_job::batch::{
@@ -59,6 +60,18 @@ fn method_settings(options: Option<&Bound<'_, PyDict>>) -> PyResult<Settings> {
                     other => {
                         return Err(PyValueError::new_err(format!(
                             "blend must be \"pou\" or \"paper\", got {other:?}"
+                        )))
+                    }
+                });
+            }
+            "binding" => {
+                let name: String = value.extract().map_err(wrong_type)?;
+                settings.binding = Some(match name.as_str() {
+                    "smooth" => Binding::Smooth,
+                    "rigid" => Binding::Rigid,
+                    other => {
+                        return Err(PyValueError::new_err(format!(
+                            "binding must be \"smooth\" or \"rigid\", got {other:?}"
                         )))
                     }
                 });

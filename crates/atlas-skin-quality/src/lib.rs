@@ -12,6 +12,7 @@ pub mod bench_compare;
 pub mod bench_page;
 pub mod bench_run;
 pub mod gltf_skins;
+pub mod rigid_binding;
 pub mod run;
 pub mod scoring;
 pub mod single_joint;
