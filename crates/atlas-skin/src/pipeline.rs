@@ -262,7 +262,7 @@ pub fn skin(
     let (mut surface_weights, weight_counts) =
         compute_weights(&decomposition, &skeleton, &overlaps, params.blend)?;
     if params.binding == Binding::Rigid {
-        surface_weights = bind_rigidly(&surface_weights);
+        surface_weights = bind_rigidly(&surface_weights, &skeleton);
     }
     if !weight_counts.twins_given_a_share.is_empty() {
         warnings.push(format!(
