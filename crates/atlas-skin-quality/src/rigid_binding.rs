@@ -148,6 +148,21 @@ pub fn summarize(results: &[BothWays]) -> Option<Summary> {
     })
 }
 
+/// The figures of both ways side by side, `smooth → rigid`: deform mean, deform max, L1,
+/// one-joint share.
+fn side_by_side(smooth: &Judged, rigid: &Judged) -> [String; 4] {
+    [
+        format!("{:.4} → {:.4}", smooth.deform_mean, rigid.deform_mean),
+        format!("{:.4} → {:.4}", smooth.deform_max, rigid.deform_max),
+        format!("{:.3} → {:.3}", smooth.l1, rigid.l1),
+        format!(
+            "{:.1}% → {:.1}%",
+            100.0 * smooth.one_joint,
+            100.0 * rigid.one_joint
+        ),
+    ]
+}
+
 /// The markdown table of `results` under `title`: one row per character (deform mean and
 /// max, L1, one-joint share, smooth → rigid), then the summary line.
 pub fn table(title: &str, results: &[BothWays]) -> String {
@@ -157,39 +172,23 @@ pub fn table(title: &str, results: &[BothWays]) -> String {
          --- | --- | --- | --- |\n"
     );
     for r in results {
+        let [mean, max, l1, one_joint] = side_by_side(&r.smooth, &r.rigid);
+        let ratio = r.rigid.deform_mean / r.smooth.deform_mean;
         out += &format!(
-            "| {} | {} | {:.4} → {:.4} | {:.2} | {:.3} → {:.3} | {:.3} → {:.3} | {:.1}% → {:.1}% |\n",
-            r.name,
-            r.vertices,
-            r.smooth.deform_mean,
-            r.rigid.deform_mean,
-            r.rigid.deform_mean / r.smooth.deform_mean,
-            r.smooth.deform_max,
-            r.rigid.deform_max,
-            r.smooth.l1,
-            r.rigid.l1,
-            100.0 * r.smooth.one_joint,
-            100.0 * r.rigid.one_joint,
+            "| {} | {} | {mean} | {ratio:.2} | {max} | {l1} | {one_joint} |\n",
+            r.name, r.vertices
         );
     }
     if let Some(s) = summarize(results) {
+        let [mean, max, l1, one_joint] = side_by_side(&s.smooth, &s.rigid);
         out += &format!(
             "\n{title}: {} characters; rigid deform mean below smooth on {} ({:.1}%); every \
              vertex on one joint with weight 1 in {} rigid files; averages smooth → rigid: \
-             deform mean {:.4} → {:.4}, max {:.4} → {:.4}, L1 {:.3} → {:.3}, one joint {:.1}% → \
-             {:.1}%\n",
+             deform mean {mean}, max {max}, L1 {l1}, one joint {one_joint}\n",
             s.characters,
             s.rigid_better,
             100.0 * s.rigid_better as f64 / s.characters as f64,
             s.rigid_all_one_joint,
-            s.smooth.deform_mean,
-            s.rigid.deform_mean,
-            s.smooth.deform_max,
-            s.rigid.deform_max,
-            s.smooth.l1,
-            s.rigid.l1,
-            100.0 * s.smooth.one_joint,
-            100.0 * s.rigid.one_joint,
         );
     }
     out

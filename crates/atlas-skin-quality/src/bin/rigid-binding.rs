@@ -50,8 +50,8 @@ struct Args {
     #[arg(long = "set", value_enum)]
     sets: Vec<SetArg>,
     /// Characters run at once; default: the number of cores.
-    #[arg(long)]
-    jobs: Option<usize>,
+    #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
+    jobs: Option<u16>,
     /// Folder for the skinned characters and their reports.
     #[arg(long, default_value = concat!(env!("CARGO_MANIFEST_DIR"), "/../../target/rigid-binding"))]
     work: PathBuf,
@@ -60,12 +60,10 @@ struct Args {
 fn main() -> Result<()> {
     let args = Args::parse();
     let exe = run::atlas_skin_exe()?;
-    let jobs = args
-        .jobs
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-    if jobs == 0 {
-        bail!("--jobs must be at least 1");
-    }
+    let jobs = args.jobs.map_or_else(
+        || std::thread::available_parallelism().map_or(1, |n| n.get()),
+        usize::from,
+    );
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(jobs)
         .build()
@@ -86,8 +84,8 @@ fn main() -> Result<()> {
             characters
                 .par_iter()
                 .map(|c| {
-                    let judged = judge_both_ways(&exe, c, &args.work)
-                        .with_context(|| format!("{}", c.name))?;
+                    let judged =
+                        judge_both_ways(&exe, c, &args.work).with_context(|| c.name.clone())?;
                     eprintln!(
                         "  {:<32} deform mean {:.4} → {:.4}",
                         c.name, judged.smooth.deform_mean, judged.rigid.deform_mean
