@@ -70,7 +70,7 @@ class OBJECT_OT_parent_atlas_skin(bpy.types.Operator):
                 "RIGID",
                 "Rigid",
                 "One bone per vertex, weight 1: the same parts, each vertex moving with the "
-                "bone that holds most of its blended weights",
+                "deepest bone whose branch holds more than half of its blended weights",
             ),
         ),
         default="SMOOTH",

@@ -57,8 +57,8 @@ pub struct MethodArgs {
     #[arg(long, value_enum)]
     pub blend: Option<BlendArg>,
     /// Blended weights (default), or one joint per vertex for a character its artist would
-    /// bind rigidly: the same cuts, each vertex moving with the heaviest joint of its
-    /// blended weights.
+    /// bind rigidly: the same cuts, each vertex moving with the deepest joint whose branch
+    /// holds more than half of its blended weights.
     #[arg(long, value_enum)]
     pub binding: Option<BindingArg>,
     /// Give this joint a boundary even where the rules would not, also one named as a

@@ -28,8 +28,9 @@ class MethodOptions(TypedDict, total=False):
     - ``blend``: ``"pou"`` (default: the normalised partition of unity, continuous
       everywhere) or ``"paper"`` (the paper's Eq. 1) (``--blend``).
     - ``binding``: ``"smooth"`` (default: blended weights) or ``"rigid"`` (one joint per
-      vertex, weight 1: the same cuts, each vertex moving with the heaviest joint of its
-      blended weights; for a character its artist would bind rigidly) (``--binding``).
+      vertex, weight 1, for a character its artist would bind rigidly: the same cuts, each
+      vertex moving with the deepest joint whose branch holds more than half of its blended
+      weights) (``--binding``).
     - ``force``: joint names given a boundary (a cut) even where the rules would not
       (``--force``).
     - ``forbid``: joint names given no boundary: their part moves with the parent's

@@ -80,8 +80,8 @@
 //!    tells them apart, and equal shares are the least wrong whatever the artist chose.
 //!
 //! 7. **Rigid binding.** When the user asks for it ([`rigid::Binding::Rigid`]), each vertex
-//!    then takes the heaviest joint of its row with weight 1 ([`rigid`]; the pipeline
-//!    applies it to the weights of steps 1–6).
+//!    then takes one joint with weight 1: the deepest joint whose subtree holds more than
+//!    half of its row ([`rigid`]; the pipeline applies it to the weights of steps 1–6).
 //!
 //! Inputs: a [`Decomposition`], the decomposed skeleton, its [`Overlaps`]
 //! ([`crate::overlap`]) and the [`Blend`]. Output: [`SurfaceWeights`], weights of every
