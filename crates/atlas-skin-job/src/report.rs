@@ -21,9 +21,9 @@ pub fn stage_timings(skinned: &Skinned) -> Map<String, Value> {
         .collect()
 }
 
-/// The JSON report: `decomposition` (the decomposition's own report, each joint with its
-/// `overlap_width` and cut `curve`, and the region of every stored vertex),
-/// `timings_ms`, `counts`, `pieces` (how each piece and each stored vertex was weighted, see
+/// The JSON report: `binding` (`smooth` or `rigid`), `decomposition` (the decomposition's
+/// own report, each joint with its `overlap_width` and cut `curve`, and the region of every
+/// stored vertex), `timings_ms`, `counts`, `pieces` (how each piece and each stored vertex was weighted, see
 /// [`TREATMENTS`]), `warnings`.
 ///
 /// - `input`: the character's name (its path, as displayed).
@@ -44,6 +44,7 @@ pub fn skin_report(
 /// order of [`serde_json::Map`]: each struct below declares its fields in that order).
 #[derive(Serialize)]
 pub struct SkinReport<'a> {
+    binding: &'static str,
     counts: ReportCounts,
     decomposition: ReportDecomposition,
     input: &'a str,
@@ -168,6 +169,7 @@ impl<'a> SkinReport<'a> {
         let weight_counts = &counts.weights;
         let warnings = report_warnings(input_warnings, skinned);
         Self {
+            binding: skinned.binding.name(),
             counts: ReportCounts {
                 duplicate_faces: counts.duplicate_faces,
                 fallback_weighted_vertices: counts.unreferenced_stored_vertices,
@@ -540,6 +542,7 @@ mod tests {
         let warnings = report_warnings(input_warnings, skinned);
         json!({
             "input": input,
+            "binding": skinned.binding.name(),
             "decomposition": decomposition_json,
             "timings_ms": timings,
             "counts": {

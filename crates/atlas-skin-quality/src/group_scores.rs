@@ -493,7 +493,10 @@ mod tests {
         assert_eq!(group_scores(&run, Group::Corpus), None);
         let page = render(&run);
         assert!(page.contains("| | tune (2) | check (2) |"), "{page}");
-        assert!(page.contains("far worse ≤ 3%: 50.0% (**not met**)"), "{page}");
+        assert!(
+            page.contains("far worse ≤ 3%: 50.0% (**not met**)"),
+            "{page}"
+        );
         assert!(page.contains("MagicArticulate"), "{page}");
     }
 }

@@ -14,6 +14,7 @@ pub mod bench_run;
 pub mod computed_baselines;
 pub mod gltf_skins;
 pub mod group_scores;
+pub mod rigid_binding;
 pub mod run;
 pub mod scoring;
 pub mod single_joint;

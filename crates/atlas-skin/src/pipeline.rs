@@ -4,8 +4,8 @@
 //! checked against the mesh ([`crate::skeleton::placement`]) and given a hierarchy when it
 //! has several roots ([`crate::skeleton::hierarchy`]) → decomposition (§3.1 cuts, §3.2 regions:
 //! [`crate::decompose()`]) → overlaps (§3.3: [`crate::overlap`]) → weights (§4, §5:
-//! [`crate::weights`], with the guard against far bones, [`crate::weights::guard`]) →
-//! un-weld (weights per stored vertex, pruned to `max_influences`).
+//! [`crate::weights`], with the guard against far bones, [`crate::weights::guard`]; one
+//! joint per vertex when bound rigidly, [`crate::weights::rigid`]) → un-weld (weights per stored vertex, pruned to `max_influences`).
 //! Settings are validated once, before any work; each stage's wall time is measured here.
 //!
 //! Inputs: a [`SkinInput`] (stored positions and triangles, the skeleton in the mesh's bind
@@ -24,6 +24,7 @@ use crate::skeleton::bones::{bone_segments, capped_extensions, nearest_bone, EXT
 use crate::skeleton::hierarchy::infer_hierarchy;
 use crate::skeleton::placement::{check_placement, decomposition_warnings, listed, PlacementError};
 use crate::weights::blend::Blend;
+use crate::weights::rigid::{bind_rigidly, Binding};
 use crate::weights::twins::LARGEST_CLASS;
 use crate::weights::{compute_weights, SurfaceWeights, WeightCounts, WeightsError};
 use atlas_skin_runtime::{RuntimeError, Skeleton, VertexWeights};
@@ -72,6 +73,8 @@ pub struct SkinParams {
     pub overlap: OverlapParams,
     /// §4: how overlapping regions are blended.
     pub blend: Blend,
+    /// Blended weights, or one joint per vertex ([`crate::weights::rigid`]).
+    pub binding: Binding,
     /// Influences kept per stored vertex, the largest, renormalised (at least 1).
     pub max_influences: usize,
     /// §4–5: rules of the weights stage switched off, to measure each alone (a developer
@@ -85,6 +88,7 @@ impl Default for SkinParams {
             decompose: DecomposeParams::default(),
             overlap: OverlapParams::default(),
             blend: Blend::default(),
+            binding: Binding::default(),
             max_influences: 4,
             weights_rules_off: RulesOff::default(),
         }
@@ -161,8 +165,11 @@ pub struct Skinned {
     pub welded_of_stored: Vec<u32>,
     pub decomposition: Decomposition,
     pub overlaps: Overlaps,
-    /// Weights of every split-surface vertex, before pruning.
+    /// Weights of every split-surface vertex, before pruning (one joint each when bound
+    /// rigidly).
     pub surface_weights: SurfaceWeights,
+    /// How the vertices were bound (the settings' [`Binding`]).
+    pub binding: Binding,
     /// Weights of every stored vertex: at most `max_influences`, summing to 1.
     pub weights: VertexWeights,
     pub timings: StageTimings,
@@ -257,13 +264,16 @@ pub fn skin(
     done(&mut timings);
 
     let done = run(Stage::Weights);
-    let (surface_weights, weight_counts) = compute_weights(
+    let (mut surface_weights, weight_counts) = compute_weights(
         &decomposition,
         &skeleton,
         &overlaps,
         params.blend,
         &params.weights_rules_off,
     )?;
+    if params.binding == Binding::Rigid {
+        surface_weights = bind_rigidly(&surface_weights, &skeleton);
+    }
     if !weight_counts.twins_given_a_share.is_empty() {
         warnings.push(format!(
             "{} joint(s) sit at the point of a joint that has weight and got none of their \
@@ -312,6 +322,7 @@ pub fn skin(
         decomposition,
         overlaps,
         surface_weights,
+        binding: params.binding,
         weights,
         timings,
         counts,

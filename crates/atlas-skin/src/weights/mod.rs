@@ -79,6 +79,10 @@
 //!    twin has some, share that twin's weight equally ([`twins`]): nothing in the geometry
 //!    tells them apart, and equal shares are the least wrong whatever the artist chose.
 //!
+//! 7. **Rigid binding.** When the user asks for it ([`rigid::Binding::Rigid`]), each vertex
+//!    then takes one joint with weight 1: the deepest joint whose subtree holds more than
+//!    half of its row ([`rigid`]; the pipeline applies it to the weights of steps 1–6).
+//!
 //! Inputs: a [`Decomposition`], the decomposed skeleton, its [`Overlaps`]
 //! ([`crate::overlap`]) and the [`Blend`]. Output: [`SurfaceWeights`], weights of every
 //! vertex of the split surface, with [`WeightCounts`] for the report; the pipeline turns
@@ -92,6 +96,7 @@ pub mod ownership;
 pub mod patches;
 pub mod pieces;
 pub mod related;
+pub mod rigid;
 pub mod siblings;
 pub mod soft_sides;
 pub mod surface_weights;

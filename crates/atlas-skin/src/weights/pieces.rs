@@ -1126,9 +1126,14 @@ mod tests {
             (1, DVec3::new(1.2, -1.0, 0.0), DVec3::new(1.2, 1.0, 0.0)),
             (2, DVec3::new(5.0, 0.0, 0.0), DVec3::new(6.0, 0.0, 0.0)),
         ];
-        let held = held_bones(&ball, &vertices, &ball.triangles, &segments, &|p| {
-            nearest_bone(&segments, p)
-        });
+        let held = held_bones(
+            &ball,
+            &vertices,
+            &ball.triangles,
+            &segments,
+            &|p| nearest_bone(&segments, p),
+            &RulesOff::default(),
+        );
         assert_eq!(joints_of(&held.segments), vec![0]);
         // Bone 3 starts inside and runs out: an eighth of it is inside. Held only when no
         // bone is held for half its length and its bones are the nearest to at least half
@@ -1136,25 +1141,40 @@ mod tests {
         let mut with_tip = segments.to_vec();
         with_tip.push((3, DVec3::new(0.0, 0.9, 0.0), DVec3::new(0.0, 1.9, 0.0)));
         let nearest_tip = |p: DVec3| nearest_bone(&with_tip, p);
-        let held = held_bones(&ball, &vertices, &ball.triangles, &with_tip, &nearest_tip);
+        let held = held_bones(
+            &ball,
+            &vertices,
+            &ball.triangles,
+            &with_tip,
+            &nearest_tip,
+            &RulesOff::default(),
+        );
         assert_eq!(joints_of(&held.segments), vec![0]);
         let tip_only = [with_tip[2], with_tip[3]];
-        let held = held_bones(&ball, &vertices, &ball.triangles, &tip_only, &|p| {
-            nearest_bone(&tip_only, p)
-        });
+        let held = held_bones(
+            &ball,
+            &vertices,
+            &ball.triangles,
+            &tip_only,
+            &|p| nearest_bone(&tip_only, p),
+            &RulesOff::default(),
+        );
         assert_eq!(joints_of(&held.segments), vec![3]);
         let cap = faces_above(&ball, 0.8);
         assert!(!cap.is_empty());
         let mut cap_vertices: Vec<u32> = cap.iter().flatten().copied().collect();
         cap_vertices.sort_unstable();
         cap_vertices.dedup();
-        assert!(
-            held_bones(&ball, &cap_vertices, &cap, &segments, &|p| nearest_bone(
-                &segments, p
-            ))
-            .segments
-            .is_empty()
-        );
+        assert!(held_bones(
+            &ball,
+            &cap_vertices,
+            &cap,
+            &segments,
+            &|p| nearest_bone(&segments, p),
+            &RulesOff::default()
+        )
+        .segments
+        .is_empty());
     }
 
     #[test]
@@ -1164,9 +1184,14 @@ mod tests {
         let vertices: Vec<u32> = (0..ball.positions.len() as u32).collect();
         let far = (1, DVec3::new(5.0, 0.0, 0.0), DVec3::new(6.0, 0.0, 0.0));
         let held_with = |segments: &[(u32, DVec3, DVec3)]| {
-            held_bones(&ball, &vertices, &ball.triangles, segments, &|p| {
-                nearest_bone(segments, p)
-            })
+            held_bones(
+                &ball,
+                &vertices,
+                &ball.triangles,
+                segments,
+                &|p| nearest_bone(segments, p),
+                &RulesOff::default(),
+            )
             .segments
         };
         // Joint 0 sits outside the ball but inside its box, its bone running away from it:
@@ -1256,16 +1281,26 @@ mod tests {
         let across = (0, DVec3::new(0.3, -0.42, 0.0), DVec3::new(0.3, 0.38, 0.0));
         let along = (1, DVec3::new(0.0, 0.4, 0.0), DVec3::new(4.0, 0.4, 0.0));
         let segments = [across, along];
-        let held = held_bones(&strap, &vertices, &strap.triangles, &segments, &|p| {
-            nearest_bone(&segments, p)
-        });
+        let held = held_bones(
+            &strap,
+            &vertices,
+            &strap.triangles,
+            &segments,
+            &|p| nearest_bone(&segments, p),
+            &RulesOff::default(),
+        );
         assert!(held.segments.is_empty(), "{:?}", held.segments);
         // With the other bone far away, the bone that pokes in is the nearest to all of it.
         let far = (1, DVec3::new(0.0, 5.0, 0.0), DVec3::new(4.0, 5.0, 0.0));
         let segments = [across, far];
-        let held = held_bones(&strap, &vertices, &strap.triangles, &segments, &|p| {
-            nearest_bone(&segments, p)
-        });
+        let held = held_bones(
+            &strap,
+            &vertices,
+            &strap.triangles,
+            &segments,
+            &|p| nearest_bone(&segments, p),
+            &RulesOff::default(),
+        );
         assert_eq!(joints_of(&held.segments), vec![0]);
     }
 

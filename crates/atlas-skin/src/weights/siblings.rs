@@ -220,7 +220,7 @@ impl<'a> Family<'a> {
 
 /// Each joint's depth (its number of ancestors), parents first in one pass: walking up
 /// from every joint would cost the square of a chain's length.
-fn depths(skeleton: &Skeleton) -> Vec<u32> {
+pub(crate) fn depths(skeleton: &Skeleton) -> Vec<u32> {
     let mut depths = vec![0; skeleton.len()];
     for j in skeleton.topological_order() {
         if let Some(p) = skeleton.parent(j) {
