@@ -87,7 +87,7 @@ class OBJECT_OT_parent_atlas_skin(bpy.types.Operator):
     )
     use_tails: BoolProperty(
         name="Bone Tails",
-        description="Leaf bones end at their tails (face bones move a patch of skin); off, "
+        description="Leaf bones end at their tails; off, "
         "bones are their heads only, as in a glTF file, whose tails Blender's importer guesses",
         default=True,
     )

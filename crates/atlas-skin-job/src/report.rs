@@ -62,14 +62,11 @@ struct ReportCounts {
     far_bone_vertices: usize,
     inside_out_pieces: usize,
     joints: usize,
-    leaf_patches: usize,
     max_influences: usize,
     off_carrier_vertices: usize,
     regions: usize,
     sibling_blend_vertices: usize,
     surface_vertices: usize,
-    twins_given_a_share: usize,
-    twins_too_many_to_share: usize,
     unreachable_vertices: usize,
     vertices: usize,
     welded_vertices: usize,
@@ -79,7 +76,6 @@ struct ReportCounts {
 /// vertex's region, fields in sorted order.
 #[derive(Serialize)]
 struct ReportDecomposition {
-    bone_axis: Option<String>,
     cuts: usize,
     joints: Vec<ReportJoint>,
     regions: Vec<ReportRegion>,
@@ -176,14 +172,11 @@ impl<'a> SkinReport<'a> {
                 far_bone_vertices: weight_counts.far_bone_vertices,
                 inside_out_pieces: counts.inside_out_pieces,
                 joints: counts.joints,
-                leaf_patches: weight_counts.leaf_patches.len(),
                 max_influences: skinned.weights.max_influences(),
                 off_carrier_vertices: weight_counts.off_carrier,
                 regions: decomposition.regions.len(),
                 sibling_blend_vertices: weight_counts.sibling_blend_vertices,
                 surface_vertices: counts.surface_vertices,
-                twins_given_a_share: weight_counts.twins_given_a_share.len(),
-                twins_too_many_to_share: weight_counts.twins_too_many_to_share,
                 unreachable_vertices: weight_counts.unreachable,
                 vertices: counts.stored_vertices,
                 welded_vertices: counts.welded_vertices,
@@ -302,7 +295,6 @@ impl ReportDecomposition {
             })
             .collect();
         ReportDecomposition {
-            bone_axis: report.bone_axis,
             cuts: report.cuts,
             joints,
             regions,
@@ -554,11 +546,8 @@ mod tests {
                 "unreachable_vertices": weight_counts.unreachable,
                 "fallback_weighted_vertices": counts.unreferenced_stored_vertices,
                 "max_influences": skinned.weights.max_influences(),
-                "leaf_patches": weight_counts.leaf_patches.len(),
                 "far_bone_vertices": weight_counts.far_bone_vertices,
                 "sibling_blend_vertices": weight_counts.sibling_blend_vertices,
-                "twins_given_a_share": weight_counts.twins_given_a_share.len(),
-                "twins_too_many_to_share": weight_counts.twins_too_many_to_share,
                 "off_carrier_vertices": weight_counts.off_carrier,
                 "duplicate_faces": counts.duplicate_faces,
                 "inside_out_pieces": counts.inside_out_pieces,

@@ -16,35 +16,19 @@ pub enum Rule {
     /// Cuts, rule 1: joints named as helpers (attachment slots, locators, IK targets) move
     /// no skin ([`crate::skeleton::helpers`]).
     HelperNames,
-    /// Cuts, rule 2: a root outside the mesh whose one child is inside moves no skin.
-    MotionRoots,
     /// Cuts, rule 4: a branching joint on the mirror plane whose branches start within its
     /// section gets a soft boundary instead of a searched cut.
     MirrorBranching,
-    /// Cuts, rule 5 (c): a leaf whose part runs off its bone is cut only where a closed cut
-    /// fits (else an end site); off, it is an end site.
-    LeafOffAxis,
-    /// Cuts, rule 5 (d): a leaf whose part runs on past it on the piece around its upper
+    /// Cuts, rule 5 (c): a leaf whose part runs on past it on the piece around its upper
     /// bone owns it; off, it is an end site.
     LeafPartPast,
-    /// Cuts, rule 7: children that spread and fold back leave the upper bone as the lower.
-    SpreadChildren,
-    /// Cuts: a leaf takes its direction from its bind frame's bone axis
-    /// ([`crate::skeleton::bone_axis`]); off, from its upper bone.
-    LeafBoneAxis,
-    /// Cuts: a joint whose best section is much wider than its parent's is placed last.
-    WideSections,
     /// Cuts: a joint keeps its cut only when its mirror twin gets one too.
     MirrorTwins,
-    /// Weights, step 3b: leaf bones lying in the skin move a patch of it.
-    LeafPatches,
-    /// Weights, step 3c: sibling joints that share a vertex give part of their weight to
+    /// Weights, step 3b: sibling joints that share a vertex give part of their weight to
     /// their lowest common ancestor.
     SiblingBlends,
     /// Weights, step 4: weights on bones far from the vertex are removed.
     FarBoneGuard,
-    /// Weights, step 6: joints at one point without weight share their twin's.
-    TwinShares,
     /// Weights, step 3: κ_c keeps a soft joint on its own part (its own bones clearly the
     /// nearest, [`crate::weights::ownership`]); off, κ_c = 1.
     OwnPart,
@@ -82,20 +66,13 @@ pub enum Rule {
 
 impl Rule {
     /// Every rule, in the order of docs/ablation.md.
-    pub const ALL: [Rule; 25] = [
+    pub const ALL: [Rule; 18] = [
         Rule::HelperNames,
-        Rule::MotionRoots,
         Rule::MirrorBranching,
-        Rule::LeafOffAxis,
         Rule::LeafPartPast,
-        Rule::SpreadChildren,
-        Rule::LeafBoneAxis,
-        Rule::WideSections,
         Rule::MirrorTwins,
-        Rule::LeafPatches,
         Rule::SiblingBlends,
         Rule::FarBoneGuard,
-        Rule::TwinShares,
         Rule::OwnPart,
         Rule::PastPlane,
         Rule::FarEndSeeds,
@@ -112,7 +89,7 @@ impl Rule {
 
     /// Whether the rule belongs to the cut stage (else to the weights).
     pub fn is_cut_rule(self) -> bool {
-        self < Rule::LeafPatches
+        self < Rule::SiblingBlends
     }
 }
 

@@ -22,10 +22,9 @@ use crate::overlap::{compute_overlaps, OverlapError, OverlapParams, Overlaps};
 use crate::rows::{Rows, PAR_CHUNK};
 use crate::skeleton::bones::{bone_segments, capped_extensions, nearest_bone, EXTENSION_JOINTS};
 use crate::skeleton::hierarchy::infer_hierarchy;
-use crate::skeleton::placement::{check_placement, decomposition_warnings, listed, PlacementError};
+use crate::skeleton::placement::{check_placement, decomposition_warnings, PlacementError};
 use crate::weights::blend::Blend;
 use crate::weights::rigid::{bind_rigidly, Binding};
-use crate::weights::twins::LARGEST_CLASS;
 use crate::weights::{compute_weights, SurfaceWeights, WeightCounts, WeightsError};
 use atlas_skin_runtime::{RuntimeError, Skeleton, VertexWeights};
 use glam::{DVec3, Vec3};
@@ -273,27 +272,6 @@ pub fn skin(
     )?;
     if params.binding == Binding::Rigid {
         surface_weights = bind_rigidly(&surface_weights, &skeleton);
-    }
-    if !weight_counts.twins_given_a_share.is_empty() {
-        warnings.push(format!(
-            "{} joint(s) sit at the point of a joint that has weight and got none of their \
-             own: each shares its twins' weight equally (nothing in the geometry tells them \
-             apart): {}",
-            weight_counts.twins_given_a_share.len(),
-            listed(
-                weight_counts
-                    .twins_given_a_share
-                    .iter()
-                    .map(|&j| skeleton.names[j as usize].clone())
-            )
-        ));
-    }
-    if weight_counts.twins_too_many_to_share > 0 {
-        warnings.push(format!(
-            "{} joints sit at one point in classes of more than {LARGEST_CLASS}: their \
-             weight is not shared among them, each keeps what the rules gave it",
-            weight_counts.twins_too_many_to_share
-        ));
     }
     let weights = unweld_weights(
         &surface_weights,

@@ -81,9 +81,8 @@ def compute_weights(
       joint to its tail (without one, it continues the parent's bone by half its length).
     - ``inverse_bind``: ``(J, 4, 4)`` floats, the inverse of each joint's bind frame
       (``M[row, column]`` acting on column vectors, as ``load`` returns them); their
-      translations must place the joints at ``joint_positions``. When the frames run along
-      the bones (a Blender or Maya rig), a leaf joint takes its direction from its frame
-      (the report's ``decomposition.bone_axis``); without them every frame is the world's.
+      translations must place the joints at ``joint_positions``. The weights do not depend
+      on the frames' rotations; without them every frame is the world's.
     - ``names``: ``J`` unique joint names (default ``joint0``, ``joint1``, ...): the names
       that ``overlap_joints``, ``force`` and ``forbid`` use, and that the report shows.
     - ``end_joints``: joints that move nothing (the leaves of a TGF skeleton, libigl's
