@@ -32,14 +32,9 @@ pub enum Rule {
     /// Weights, step 3: κ_c keeps a soft joint on its own part (its own bones clearly the
     /// nearest, [`crate::weights::ownership`]); off, κ_c = 1.
     OwnPart,
-    /// Weights, step 3: π_c carries a soft joint's part past its plane where the bones of
-    /// its descendants without a boundary are the nearest; off, π_c = 0.
-    PastPlane,
-    /// Weights, step 3: a soft side whose band holds no vertex is seeded from the far ends
-    /// of the edges that span its band.
-    FarEndSeeds,
-    /// Weights, step 3: failing that, a joint with child bones (or a leaf whose part runs
-    /// on past it) is seeded within the nearest vertex's distance plus its band.
+    /// Weights, step 3: a soft side whose band holds no vertex, of a joint with child bones
+    /// (or a leaf whose part runs on past it), is seeded within the nearest vertex's
+    /// distance plus its band.
     FartherSeeds,
     /// Weights, step 3: failing that, a free joint with child bones is seeded from its own
     /// part (chains along sheets).
@@ -49,24 +44,17 @@ pub enum Rule {
     ContinuedSoftSides,
     /// Weights, step 5: a piece that no bone enters holds the bones around it.
     PiecesBonesAround,
-    /// Weights, step 5: a bone that only pokes into a piece holds it only where it is the
-    /// nearest bone to half of its vertices.
-    PiecesPokingBones,
-    /// Weights, step 5: a piece that encloses a free joint holds its bones.
-    PiecesEnclosedJoints,
     /// Weights, step 5: a piece that holds no bone is carried by the joints where it
     /// touches the body, and its weights spread from that contact.
     PiecesContact,
     /// Weights, step 5: an attached piece moves with one part of the skeleton, the one that
     /// carries most of it ([`crate::weights::carriers`]).
     PiecesOneCarrier,
-    /// Weights, step 5: a piece small next to its joint's bone is rigid to it.
-    PiecesSmallRigid,
 }
 
 impl Rule {
     /// Every rule, in the order of docs/ablation.md.
-    pub const ALL: [Rule; 18] = [
+    pub const ALL: [Rule; 13] = [
         Rule::HelperNames,
         Rule::MirrorBranching,
         Rule::LeafPartPast,
@@ -74,17 +62,12 @@ impl Rule {
         Rule::SiblingBlends,
         Rule::FarBoneGuard,
         Rule::OwnPart,
-        Rule::PastPlane,
-        Rule::FarEndSeeds,
         Rule::FartherSeeds,
         Rule::OwnPartSeeds,
         Rule::ContinuedSoftSides,
         Rule::PiecesBonesAround,
-        Rule::PiecesPokingBones,
-        Rule::PiecesEnclosedJoints,
         Rule::PiecesContact,
         Rule::PiecesOneCarrier,
-        Rule::PiecesSmallRigid,
     ];
 
     /// Whether the rule belongs to the cut stage (else to the weights).

@@ -15,11 +15,6 @@ pub const RAY_PARALLEL: f64 = 1e-14;
 /// skeleton's or the mesh's diagonal (cubed for a volume).
 pub const NEGLIGIBLE: f64 = 1e-9;
 
-/// Two joints closer than this fraction of the skeleton's diagonal sit at one point
-/// (bind matrices are stored in single precision; inverted, they place such twins a few
-/// millionths apart).
-pub const SAME_POINT: f64 = 1e-5;
-
 /// Squared normal length under which a triangle's plane is undefined: only a guard
 /// against dividing by zero (nearly flat triangles are measured by their edges).
 pub const NORMAL_UNDERFLOW: f64 = 1e-300;

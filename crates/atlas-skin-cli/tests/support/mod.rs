@@ -107,14 +107,6 @@ impl BenchSkin {
             .collect()
     }
 
-    /// The first piece or gap of `vertices` vertices among [`Self::whole_pieces`].
-    pub fn whole_piece(&self, vertices: u64) -> &serde_json::Value {
-        self.whole_pieces_of(vertices)
-            .first()
-            .copied()
-            .unwrap_or_else(|| panic!("no piece of {vertices} vertices weighted as a whole"))
-    }
-
     /// Asserts that every piece of `vertices` vertices ([`Self::whole_pieces_of`], at least
     /// one) is rigid to the joint named `joint`; returns how many there are.
     pub fn assert_rigid(&self, vertices: u64, joint: &str) -> usize {

@@ -4,22 +4,17 @@
 //! within a radius, from the cells of the radius's box. (The nearest bone:
 //! [`super::bone_tree`].) And the joints that sit at one point, from such a grid.
 
-use crate::geometry::bounding_box;
 use crate::mesh::spatial_index::CentreGrid;
-use crate::mesh::union_find::UnionFind;
-use crate::tolerance::SAME_POINT;
-use atlas_skin_runtime::Skeleton;
 use glam::{DVec3, IVec3};
-use std::cmp::Ordering;
 
-/// A skeleton's bind positions, and which of its joints sit at one point: within
-/// [`SAME_POINT`] × the diagonal of the joints' bounding box. Found from a grid of the
+/// A skeleton's bind positions, and which of its joints sit at one point: within a radius
+/// of each other. Found from a grid of the
 /// distinct positions, the joints at each visited together: no pair of joints is visited,
 /// so a skeleton of thousands of joints bound at one point (a broken file) costs as much
 /// as one of thousands apart.
 pub struct JointPoints {
     /// #J bind positions.
-    pub bind: Vec<DVec3>,
+    bind: Vec<DVec3>,
     /// The distinct bind positions; the joints at position p are
     /// `joints[first[p]..first[p + 1]]`, increasing.
     first: Vec<usize>,
@@ -29,17 +24,6 @@ pub struct JointPoints {
 }
 
 impl JointPoints {
-    /// The joints within [`SAME_POINT`] × the diagonal of their bounding box.
-    pub fn new(skeleton: &Skeleton) -> Self {
-        let bind: Vec<DVec3> = skeleton
-            .bind_positions()
-            .iter()
-            .map(|p| p.as_dvec3())
-            .collect();
-        let (lo, hi) = bounding_box(&bind);
-        Self::within_radius(bind, SAME_POINT * (hi - lo).length())
-    }
-
     /// The joints at `bind` within `radius` of each other.
     pub fn within_radius(bind: Vec<DVec3>, radius: f64) -> Self {
         let key = |j: u32| bind[j as usize].to_array().map(f64::to_bits);
@@ -116,53 +100,6 @@ impl JointPoints {
     /// Whether joints j and k sit at one point.
     pub fn same_point(&self, j: usize, k: usize) -> bool {
         self.bind[j].distance(self.bind[k]) <= self.radius
-    }
-
-    /// Classes of the joints that `keep` accepts: two such siblings (children of one
-    /// parent, or two roots) at one point belong to one class, and so do siblings at one
-    /// point with a member of the class in turn. Every other joint is a class of its own.
-    pub fn sibling_classes(&self, skeleton: &Skeleton, keep: impl Fn(usize) -> bool) -> UnionFind {
-        let mut classes = UnionFind::new(self.bind.len());
-        // Per distinct position, (parent, first joint there with that parent), by parent:
-        // the joints at one position and with one parent are one class at once.
-        let groups: Vec<Vec<(u32, u32)>> = (0..self.positions())
-            .map(|p| {
-                let mut group: Vec<(u32, u32)> = self
-                    .joints_at(p)
-                    .iter()
-                    .filter(|&&j| keep(j as usize))
-                    .map(|&j| (skeleton.parents[j as usize], j))
-                    .collect();
-                group.sort_unstable();
-                group.dedup_by(|later, kept| {
-                    let same = later.0 == kept.0;
-                    if same {
-                        classes.union(later.1, kept.1);
-                    }
-                    same
-                });
-                group
-            })
-            .collect();
-        // Positions apart but at one point: their groups of one parent join.
-        for (p, group) in groups.iter().enumerate() {
-            for q in self.positions_after(p) {
-                let other = &groups[q];
-                let (mut a, mut b) = (0, 0);
-                while a < group.len() && b < other.len() {
-                    match group[a].0.cmp(&other[b].0) {
-                        Ordering::Less => a += 1,
-                        Ordering::Greater => b += 1,
-                        Ordering::Equal => {
-                            classes.union(group[a].1, other[b].1);
-                            a += 1;
-                            b += 1;
-                        }
-                    }
-                }
-            }
-        }
-        classes
     }
 }
 
@@ -268,59 +205,6 @@ fn shells(grid: &CentreGrid, p: DVec3, visit: &mut impl FnMut(u32) -> f64) {
 mod tests {
     use super::*;
     use atlas_skin_runtime::random_pose::SplitMix64;
-    use atlas_skin_runtime::NO_PARENT;
-
-    /// The classes of siblings at one point: the same as the reference, a union of every
-    /// pair of kept siblings within the radius, on skeletons with thousands of joints at
-    /// one position, clusters of positions closer than the radius (chains of them), and
-    /// joints apart; every parent, several roots, joints left out.
-    #[test]
-    fn sibling_classes_as_a_scan_of_every_pair() {
-        let mut rng = SplitMix64::new(7);
-        let below = |rng: &mut SplitMix64, n: usize| (rng.next_u64() % n as u64) as usize;
-        for case in 0..12 {
-            let count = [3, 40, 300, 2000][case % 4];
-            let parents_apart = 1 + case % 3;
-            // Positions: a few centres, each joint at one exactly or moved by up to about
-            // the radius (the diagonal is about 1, the radius 10⁻⁵ of it).
-            let step = 0.7e-5;
-            let centres: Vec<DVec3> = (0..1 + case % 5)
-                .map(|_| DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64()))
-                .collect();
-            let mut positions = Vec::new();
-            let mut parents = Vec::new();
-            for j in 0..count {
-                let centre = centres[below(&mut rng, centres.len())];
-                let moved = match below(&mut rng, 3) {
-                    0 => DVec3::ZERO,
-                    1 => DVec3::X * step * below(&mut rng, 4) as f64,
-                    _ => DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64()) * 0.3,
-                };
-                positions.push((centre + moved).as_vec3());
-                parents.push(match j {
-                    0 => NO_PARENT,
-                    _ if below(&mut rng, 10) == 0 => NO_PARENT,
-                    _ => below(&mut rng, j.min(parents_apart)) as u32,
-                });
-            }
-            let names = (0..count).map(|j| format!("j{j}")).collect();
-            let skeleton = Skeleton::from_positions(names, parents, &positions).unwrap();
-            let points = JointPoints::new(&skeleton);
-            let keep = |j: usize| j % 7 != 3;
-            let mut reference = UnionFind::new(count);
-            for j in (0..count).filter(|&j| keep(j)) {
-                for k in (j + 1..count).filter(|&k| keep(k)) {
-                    if skeleton.parents[j] == skeleton.parents[k] && points.same_point(j, k) {
-                        reference.union(j as u32, k as u32);
-                    }
-                }
-            }
-            let mut classes = points.sibling_classes(&skeleton, keep);
-            for j in 0..count as u32 {
-                assert_eq!(classes.find(j), reference.find(j), "case {case}, joint {j}");
-            }
-        }
-    }
 
     /// Clustered, collinear, coincident and spread points, queried inside and far outside
     /// their box: the same nearest point and distance as a scan of every point, and the same points

@@ -87,12 +87,12 @@ pub fn region_trees(
         .collect()
 }
 
-/// Per vertex, the (soft side, κ_c, π_c) of every soft side reaching it.
-fn soft_reaches(softs: &[SoftSide], vertex_count: usize) -> Rows<(u32, f64, f64)> {
+/// Per vertex, the (soft side, κ_c) of every soft side reaching it.
+fn soft_reaches(softs: &[SoftSide], vertex_count: usize) -> Rows<(u32, f64)> {
     let entries = softs.iter().enumerate().flat_map(|(s, soft)| {
         soft.reached()
             .iter()
-            .map(move |&(v, kappa, beyond)| (v as usize, (s as u32, kappa, beyond)))
+            .map(move |&(v, kappa)| (v as usize, (s as u32, kappa)))
     });
     Rows::group(vertex_count, entries)
 }
@@ -142,14 +142,14 @@ pub fn blend_vertices(
             for (&(r, _), &omega) in regions.iter().zip(&scratch.region_weights) {
                 let tree = &trees[r as usize];
                 scratch.shares.clear();
-                scratch.shares.extend(soft_reaches.row(v).iter().filter_map(
-                    |&(s, kappa, beyond)| {
+                scratch
+                    .shares
+                    .extend(soft_reaches.row(v).iter().filter_map(|&(s, kappa)| {
                         let soft = &softs[s as usize];
                         let node = node_of_soft[s as usize].filter(|_| soft.region == r)?;
-                        let share = soft.share(positions[v], kappa, beyond);
+                        let share = soft.share(positions[v], kappa);
                         (share > 0.0).then_some((node, share))
-                    },
-                ));
+                    }));
                 scratch.shares.sort_unstable_by_key(|&(node, _)| node);
                 let mass = &mut scratch.mass;
                 share_along_chain(tree, &scratch.shares, omega, mass, &mut scratch.parents);

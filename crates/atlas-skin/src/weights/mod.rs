@@ -16,7 +16,7 @@
 //! 3. **Chain weights inside a region.** A region is bound to its first joint; each other
 //!    joint of the region with a soft boundary also moves part of it. Joint c's soft boundary
 //!    (plane point o_c, normal n_c toward its child, half-width w_c) gives
-//!    s_c(p) = max(β(clamp((w_c + n_c·(p − o_c)) / (2 w_c), 0, 1)), π_c(p)) · κ_c(p) on its
+//!    s_c(p) = β(clamp((w_c + n_c·(p − o_c)) / (2 w_c), 0, 1)) · κ_c(p) on its
 //!    child side and 0 elsewhere. κ_c ([`crate::weights::ownership`]) keeps the joint on its own
 //!    part: with a(p) the distance from p to the nearest of the joint's own bones (its child
 //!    bones and every bone below them) and b(p) to the nearest other bone of the region
@@ -29,10 +29,6 @@
 //!    (a jaw's, the front of the neck) leaves that part to the bones that run inside it,
 //!    and a clavicle leaves the chest, about as near to the spine as to the clavicle, to
 //!    the spine.
-//!    π_c, the same formula (λ = 1) with the bones of c's descendants that have no boundary of
-//!    their own as own bones and c's child bones plus the region's other bones as others,
-//!    carries c's part past its plane where such a bone is the nearest: a chin that hangs
-//!    below the plane of the head joint but lies on the jaw bone moves with the head.
 //!    The region's joints form a tree (each soft joint under its nearest ancestor among
 //!    them, the bound joint at the root). Visiting the nodes parents first, the children c
 //!    of a node take, with S = Σ_c s_c, the share min(1, S) of the mass of every node on
@@ -44,14 +40,13 @@
 //!
 //!    The child side is not a half-space: it is the set of vertices reached *along the
 //!    surface* from the joint's own cross-section (vertices within the plane's band and
-//!    near the joint) without crossing the far edge of the band (n_c·(p − o_c) ≤ −w_c)
-//!    where π_c = 0, leaving the region and its overlaps, or reaching κ_c = 0. A plane
+//!    near the joint) without crossing the far edge of the band (n_c·(p − o_c) ≤ −w_c),
+//!    leaving the region and its overlaps, or reaching κ_c = 0. A plane
 //!    through a shoulder therefore never reaches a thigh that the hand touches, and a soft
 //!    boundary acts only inside its own region: the surface-distance guarantee of §3.3
-//!    holds for soft boundaries too (κ_c and π_c, Euclidean nearest-bone tests, only ever
-//!    remove vertices from the flood or extend it within the region, never across a
-//!    region's edge). A soft boundary with no cross-section near its joint is inactive
-//!    (see `soft_sides`).
+//!    holds for soft boundaries too (κ_c, a Euclidean nearest-bone test, only ever
+//!    removes vertices from the flood). A soft boundary with no cross-section near its
+//!    joint is inactive (see `soft_sides`).
 //!
 //!    **3b. Sibling blends.** Where two joints of which neither is an ancestor of the other
 //!    share a vertex (two thighs at a crotch, a neck and a clavicle), part of their common

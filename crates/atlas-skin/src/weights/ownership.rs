@@ -7,8 +7,7 @@
 //! bones at the joint), κ(p) = β(clamp(1 − (a − λ b) / w, 0, 1)), and 1 when the region
 //! has no other bone: 1 wherever the own bones are clearly the nearer, a ≤ λ b, falling to
 //! 0 within one half-width w past that surface. λ = [`OWN_BONE_RATIO`] for a joint with
-//! child bones; 1 for a leaf, whose own bone is a guess (half its parent's), and for the
-//! `beyond` factor.
+//! child bones; 1 for a leaf, whose own bone is a guess (half its parent's).
 //!
 //! Why λ < 1: near a soft joint the artists' weight follows the bones that are clearly
 //! nearer, not the surface equidistant from two bones. Over the soft joints with child
@@ -21,7 +20,7 @@
 //! The bones are indexed once for every joint (`OwnershipBones`): the joints numbered in
 //! depth-first order, so that the bones of a joint's subtree are one range of numbers, in
 //! hierarchies of bone boxes ([`crate::skeleton::bone_tree`]): one over every bone, one per
-//! region, one per group of the `beyond` factor. A distance costs a descent of a tree, not a
+//! region. A distance costs a descent of a tree, not a
 //! scan of the region's bones (10,000 siblings of one root: 10,000 collinear bones in one
 //! region).
 
@@ -131,42 +130,6 @@ fn depth_first_ranges(skeleton: &Skeleton) -> (Vec<u32>, Vec<u32>) {
     (order, end)
 }
 
-/// For the `beyond` factor of joints with a boundary of their own (`handled`): the bones of
-/// every joint below such a joint h with no other handled joint between them, per h.
-pub(crate) struct FreeBones {
-    groups: HashMap<u32, BoneTree>,
-}
-
-impl FreeBones {
-    pub(crate) fn new(
-        skeleton: &Skeleton,
-        segments: &[(u32, DVec3, DVec3)],
-        handled: &[bool],
-    ) -> Self {
-        // The nearest handled joint at or above each joint.
-        let mut handler: Vec<Option<usize>> = vec![None; skeleton.len()];
-        for j in skeleton.topological_order() {
-            handler[j] = if handled[j] {
-                Some(j)
-            } else {
-                skeleton.parent(j).and_then(|p| handler[p])
-            };
-        }
-        let mut groups: HashMap<u32, Vec<(u32, DVec3, DVec3)>> = HashMap::new();
-        for &(j, start, end) in segments {
-            if let Some(h) = handler[j as usize].filter(|&h| h != j as usize) {
-                groups.entry(h as u32).or_default().push((j, start, end));
-            }
-        }
-        Self {
-            groups: groups
-                .into_iter()
-                .map(|(h, bones)| (h, BoneTree::new(bones, Split::Space)))
-                .collect(),
-        }
-    }
-}
-
 /// Some bones of an [`OwnershipBones`]: those of `tree` whose keys `keys` admits, except
 /// those keyed `upper.0` that end at `upper.1` (a joint's upper bones).
 #[derive(Clone, Copy)]
@@ -177,12 +140,6 @@ struct BoneSet<'a> {
 }
 
 impl BoneSet<'_> {
-    const NONE: Self = Self {
-        tree: None,
-        keys: Keys::ALL,
-        upper: None,
-    };
-
     fn nearest_distance(&self, p: DVec3) -> f64 {
         self.tree.map_or(f64::INFINITY, |tree| {
             tree.nearest_distance(p, self.keys, |key, end| self.upper != Some((key, end)))
@@ -192,12 +149,10 @@ impl BoneSet<'_> {
 
 /// The bones that decide κ for one joint of a region.
 pub(crate) struct Ownership<'a> {
-    bones: &'a OwnershipBones,
     /// The joint's own bones: its child bones and every bone below them.
     own: BoneSet<'a>,
-    /// The other bones of the region (neither the joint's own nor its upper bone), and for
-    /// [`Ownership::beyond`] the joint's child bones.
-    other: [BoneSet<'a>; 2],
+    /// The other bones of the region (neither the joint's own nor its upper bone).
+    other: BoneSet<'a>,
     half_width: f64,
     /// λ of the module documentation.
     ratio: f64,
@@ -217,55 +172,22 @@ impl<'a> Ownership<'a> {
         let below = (bones.order[joint], bones.subtree_end[joint]);
         let upper = bones.parents[joint].map(|p| (bones.order[p], bones.positions[joint]));
         Self {
-            bones,
             own: BoneSet {
                 tree: Some(&bones.all),
                 keys: Keys::Inside(below.0, below.1),
                 upper: None,
             },
-            other: [
-                BoneSet {
-                    tree: bones.regions.get(&region),
-                    keys: Keys::Outside(below.0, below.1),
-                    upper,
-                },
-                BoneSet::NONE,
-            ],
+            other: BoneSet {
+                tree: bones.regions.get(&region),
+                keys: Keys::Outside(below.0, below.1),
+                upper,
+            },
             half_width,
             ratio: if below.1 - below.0 > 1 {
                 OWN_BONE_RATIO
             } else {
                 1.0
             },
-        }
-    }
-
-    /// The factor that carries a soft joint's part past the far edge of its plane's band
-    /// (weights, step 3): the same formula as κ with, as own bones, the bones of the
-    /// joint's descendants that no other soft boundary of the region takes (`free`: the
-    /// joints below a joint with a boundary of its own, such as `joint`, and their bones
-    /// are left out), and as other bones, the joint's own child bones and the other bones
-    /// of `self`. It is 1 where such a descendant bone is the nearest: a chin below the
-    /// plane of the neck joint above it, nearest to a jaw bone that has no boundary of its
-    /// own. `joint` must be one of the handled joints `free` was built with.
-    pub(crate) fn beyond(&self, free: &'a FreeBones, joint: usize) -> Self {
-        let key = self.bones.order[joint];
-        Self {
-            bones: self.bones,
-            own: BoneSet {
-                tree: free.groups.get(&(joint as u32)),
-                ..BoneSet::NONE
-            },
-            other: [
-                self.other[0],
-                BoneSet {
-                    tree: Some(&self.bones.all),
-                    keys: Keys::Inside(key, key + 1),
-                    upper: None,
-                },
-            ],
-            half_width: self.half_width,
-            ratio: 1.0,
         }
     }
 
@@ -276,11 +198,7 @@ impl<'a> Ownership<'a> {
         if own == f64::INFINITY {
             return 0.0;
         }
-        let other = self
-            .other
-            .iter()
-            .map(|bones| bones.nearest_distance(position))
-            .fold(f64::INFINITY, f64::min);
+        let other = self.other.nearest_distance(position);
         if other == f64::INFINITY {
             return 1.0;
         }
@@ -324,32 +242,6 @@ mod tests {
             }
         }
         (own, other)
-    }
-
-    /// The bones of [`Ownership::beyond`] by their definition, from the reference `other`.
-    fn reference_beyond(
-        skeleton: &Skeleton,
-        segments: &[(u32, DVec3, DVec3)],
-        joint: usize,
-        handled: &[bool],
-        other: &Bones,
-    ) -> (Bones, Bones) {
-        let free_descendant = |j: usize| {
-            j != joint
-                && std::iter::once(j)
-                    .chain(skeleton.ancestors(j))
-                    .find(|&a| a == joint || handled[a])
-                    == Some(joint)
-        };
-        let (mut own, mut beyond_other) = (Vec::new(), other.clone());
-        for &(j, start, end) in segments {
-            if j as usize == joint {
-                beyond_other.push([start, end]);
-            } else if free_descendant(j as usize) {
-                own.push([start, end]);
-            }
-        }
-        (own, beyond_other)
     }
 
     /// κ by the formula with plain point–segment distances, every bone scanned.
@@ -468,21 +360,14 @@ mod tests {
                     owns_skin: true,
                 })
                 .collect();
-            let handled: Vec<bool> = (0..n).map(|_| rng.next_f64() < 0.4).collect();
             let segments = bone_segments(&skeleton);
             let bones = OwnershipBones::new(&skeleton, &decisions, &segments);
-            let free = FreeBones::new(&skeleton, &segments, &handled);
             let w = 0.3;
             for joint in 0..n {
                 for region in 0..2 {
                     let (own, other) =
                         reference_bones(&skeleton, &decisions, &segments, joint, region);
                     let owner = Ownership::new(&bones, joint, region, w);
-                    let beyond = handled[joint].then(|| {
-                        let reference =
-                            reference_beyond(&skeleton, &segments, joint, &handled, &other);
-                        (owner.beyond(&free, joint), reference)
-                    });
                     for q in 0..40 {
                         let (u, v, t) = (rng.next_f64(), rng.next_f64(), rng.next_f64());
                         let p = if q % 2 == 0 {
@@ -504,14 +389,6 @@ mod tests {
                             close(got, expected),
                             "case {case}, joint {joint}, region {region} at {p}: {got} vs {expected}"
                         );
-                        if let Some((beyond, (own, other))) = &beyond {
-                            let expected = reference_kappa(own, other, 1.0, w, p);
-                            let got = beyond.at(p);
-                            assert!(
-                                close(got, expected),
-                                "beyond: case {case}, joint {joint} at {p}: {got} vs {expected}"
-                            );
-                        }
                     }
                 }
             }

@@ -3,7 +3,7 @@
 //! (module documentation of [`crate::weights`]).
 
 use super::blend::beta;
-use super::ownership::{FreeBones, Ownership, OwnershipBones};
+use super::ownership::{Ownership, OwnershipBones};
 use crate::ablation::{Rule, RulesOff};
 use crate::decomposition::{Boundary, BoundaryKind, Decomposition};
 use crate::geometry::point_segment_distance;
@@ -25,23 +25,23 @@ pub struct SoftSide {
     point: DVec3,
     normal: DVec3,
     half_width: f64,
-    /// (v, κ_c, π_c) of every vertex v on the child side reached along the surface, by
+    /// (v, κ_c) of every vertex v on the child side reached along the surface, by
     /// increasing vertex (s_c is 0 at the others).
-    reached: Vec<(u32, f64, f64)>,
+    reached: Vec<(u32, f64)>,
 }
 
 impl SoftSide {
-    /// The vertices reached along the surface with their (κ_c, π_c), by increasing vertex.
-    pub fn reached(&self) -> &[(u32, f64, f64)] {
+    /// The vertices reached along the surface with their κ_c, by increasing vertex.
+    pub fn reached(&self) -> &[(u32, f64)] {
         &self.reached
     }
 
     /// s_c(p) of the module documentation at a reached vertex at `position`, with its
-    /// `kappa` κ_c and `beyond` π_c.
-    pub fn share(&self, position: DVec3, kappa: f64, beyond: f64) -> f64 {
+    /// `kappa` κ_c.
+    pub fn share(&self, position: DVec3, kappa: f64) -> f64 {
         let signed = self.normal.dot(position - self.point);
         let w = self.half_width.max(f64::MIN_POSITIVE);
-        beta(((w + signed) / (2.0 * w)).clamp(0.0, 1.0)).max(beyond) * kappa
+        beta(((w + signed) / (2.0 * w)).clamp(0.0, 1.0)) * kappa
     }
 }
 
@@ -51,16 +51,11 @@ impl SoftSide {
 /// the joint's cross-section (within the band |n·(p − o)| ≤ w and within max(D, w) of the
 /// joint), through vertices related to the boundary's region whose signed plane distance
 /// exceeds −w and where κ > 0 ([`super::ownership`]). Where none of those vertices
-/// qualifies because one face spans the band (they lie past its far edge on the parent
-/// side: rignet-val/3615's ponytail at hair2), the seeds are the ends past the band's
-/// near edge (n·(p − o) > w) of their edges. Where still no vertex qualifies and the
-/// joint has child bones (a coarse mesh whose faces are larger than the section: KayKit's
-/// hips) or is a leaf whose part runs on past it for its bone's length
+/// qualifies and the joint has child bones (a coarse mesh whose faces are larger than the
+/// section: KayKit's hips) or is a leaf whose part runs on past it for its bone's length
 /// ([`Boundary::leaf_part_past`]), the seeds are those within d_N + max(D, w), d_N the
-/// distance from the joint to the nearest vertex of the surface; for such a leaf, failing
-/// those, the far ends of their edges as above (a tail tip in a flat sheet: its band is as
-/// thin as the joint's depth, 2r, and one face spans it; for joints with child bones this
-/// last step lost on the benchmark, docs/measurements.md). Where still none qualifies, a
+/// distance from the joint to the nearest vertex of the surface. Where still none
+/// qualifies, a
 /// joint with child bones that no region is bound to and that no other bone runs through
 /// (a hair card's or a tail's joint beside a sheet, whose band is as thin as its depth)
 /// is seeded from its own part: the vertices of its region on the child side of its plane
@@ -81,17 +76,7 @@ pub fn soft_sides(
 ) -> Vec<SoftSide> {
     let d = decomposition;
     let segments = bone_segments(skeleton);
-    // Joints with a boundary of their own (a cut, or a soft boundary with a section): π_c
-    // leaves their bones, and the bones below them, to them.
-    let mut handled = vec![false; skeleton.len()];
-    for b in &d.boundaries {
-        if b.kind != BoundaryKind::Soft || b.diameter > 0.0 {
-            handled[b.joint as usize] = true;
-        }
-    }
     let bones = OwnershipBones::new(skeleton, &d.joints, &segments);
-    // The joints of the boundaries below are all handled, as `beyond` requires.
-    let free = FreeBones::new(skeleton, &segments, &handled);
     // Every soft boundary with a section acts in its region; some also in a region that
     // continues it across a gap.
     let acting: Vec<(usize, Cow<Boundary>)> = d
@@ -120,22 +105,19 @@ pub fn soft_sides(
         let (k, b) = (*k, b.as_ref());
         let half_width = overlaps.half_widths[k];
         let owner = Ownership::new(&bones, b.joint as usize, b.parent_region, half_width);
-        let beyond = owner.beyond(&free, b.joint as usize);
         let in_region = |v: usize| related.row(v).iter().any(|&(r, _)| r == b.parent_region);
         let has_children = !children[b.joint as usize].is_empty();
         let seeds = Seeds {
             vertices: &vertices,
-            far_ends: rules_off.on(Rule::FarEndSeeds),
             beyond_nearest: (has_children || b.leaf_part_past) && rules_off.on(Rule::FartherSeeds),
             own_part: has_children
                 && !b.bone_through
                 && !bound[b.joint as usize]
                 && rules_off.on(Rule::OwnPartSeeds),
             kappa: rules_off.on(Rule::OwnPart),
-            past_plane: rules_off.on(Rule::PastPlane),
         };
         let below = |v: usize| taken.below(&bones, v, b.parent_region, b.joint);
-        child_side(d, b, half_width, &owner, &beyond, in_region, below, &seeds)
+        child_side(d, b, half_width, &owner, in_region, below, &seeds)
     };
     // The deepest joints first, those at one depth in parallel: where a joint's side takes
     // the whole share (s = 1), it takes the mass of every joint above it on its region's
@@ -184,9 +166,9 @@ impl Taken {
 
     /// Records where `side` takes the whole share, where no side did before.
     fn record(&mut self, side: &SoftSide, positions: &[DVec3]) {
-        for &(v, kappa, beyond) in side.reached() {
+        for &(v, kappa) in side.reached() {
             let slot = &mut self.by[v as usize];
-            if slot.is_none() && side.share(positions[v as usize], kappa, beyond) >= 1.0 {
+            if slot.is_none() && side.share(positions[v as usize], kappa) >= 1.0 {
                 *slot = Some((side.region, side.joint));
             }
         }
@@ -296,27 +278,21 @@ impl<'a> NearVertices<'a> {
 /// child bones that no region is bound to and that no other bone runs through).
 struct Seeds<'a> {
     vertices: &'a NearVertices<'a>,
-    /// Whether the far ends of the edges spanning the band may seed it.
-    far_ends: bool,
     beyond_nearest: bool,
     own_part: bool,
-    /// Whether κ_c applies (else 1) and π_c (else 0): developer switches
-    /// ([`crate::ablation`]).
+    /// Whether κ_c applies (else 1): a developer switch ([`crate::ablation`]).
     kappa: bool,
-    past_plane: bool,
 }
 
-/// The child side of the soft boundary `b` (half-width `half_width`, κ from `owner`, π from
-/// `beyond`): the flood of [`soft_sides`] from the vertices near the joint (found in
-/// `seeds`), through vertices where `in_region` holds (those the region reaches); `None`
-/// when no seed qualifies (an inactive boundary).
-#[allow(clippy::too_many_arguments)]
+/// The child side of the soft boundary `b` (half-width `half_width`, κ from `owner`): the
+/// flood of [`soft_sides`] from the vertices near the joint (found in `seeds`), through
+/// vertices where `in_region` holds (those the region reaches); `None` when no seed
+/// qualifies (an inactive boundary).
 fn child_side(
     d: &Decomposition,
     b: &Boundary,
     half_width: f64,
     owner: &Ownership,
-    beyond: &Ownership,
     in_region: impl Fn(usize) -> bool,
     taken_below: impl Fn(usize) -> bool,
     seeds: &Seeds,
@@ -338,20 +314,13 @@ fn child_side(
         if !in_region(v as usize) || (own_part.get() && taken_below(v as usize)) {
             return;
         }
-        let p = positions[v as usize];
-        let side = signed(v as usize);
-        // π_c matters only where the plane's own term is below 1.
-        let past = if side < half_width && seeds.past_plane {
-            beyond.at(p)
-        } else {
-            0.0
-        };
-        if side <= -half_width && past <= 0.0 {
+        if signed(v as usize) <= -half_width {
             return;
         }
+        let p = positions[v as usize];
         let kappa = if seeds.kappa { owner.at(p) } else { 1.0 };
         if kappa > 0.0 {
-            reached.push((v, kappa, past));
+            reached.push((v, kappa));
             queue.push_back(v);
         }
     };
@@ -363,33 +332,12 @@ fn child_side(
         near.retain(|&v| signed(v as usize) <= half_width);
         near
     };
-    // One face spans the band: the section crosses its edges from the vertices near the
-    // joint to the child side past the band, whose ends seed the flood.
-    let far_ends = |near: &[u32]| -> Vec<u32> {
-        near.iter()
-            .filter(|&&v| in_region(v as usize))
-            .flat_map(|&v| d.topology.neighbors(v as usize).iter().copied())
-            .filter(|&u| signed(u as usize) > half_width)
-            .collect()
-    };
-    let near = near_band(seed_radius);
-    for &v in &near {
+    for v in near_band(seed_radius) {
         visit(v, &mut queue);
     }
-    if queue.is_empty() && seeds.far_ends {
-        for u in far_ends(&near) {
-            visit(u, &mut queue);
-        }
-    }
     if queue.is_empty() && seeds.beyond_nearest {
-        let farther = near_band(seeds.vertices.nearest(b.point) + seed_radius);
-        for &v in &farther {
+        for v in near_band(seeds.vertices.nearest(b.point) + seed_radius) {
             visit(v, &mut queue);
-        }
-        if queue.is_empty() && b.leaf_part_past && seeds.far_ends {
-            for u in far_ends(&farther) {
-                visit(u, &mut queue);
-            }
         }
     }
     if queue.is_empty() && seeds.own_part {
@@ -410,7 +358,7 @@ fn child_side(
             visit(u, &mut queue);
         }
     }
-    reached.sort_unstable_by_key(|&(v, _, _)| v);
+    reached.sort_unstable_by_key(|&(v, _)| v);
     Some(SoftSide {
         joint: b.joint,
         region: b.parent_region,
