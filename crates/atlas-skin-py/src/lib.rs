@@ -433,9 +433,13 @@ fn batch<'py>(
     })?;
     // The batch runs on a thread of its own; this thread passes each finished record to
     // `progress` and checks for signals (Ctrl-C) meanwhile, stopping the batch on an
-    // exception from either.
+    // exception from either. The channel holds at most `jobs` records: a worker that
+    // finishes a file waits while this thread is that far behind, so a stop takes effect
+    // within a few files whatever `progress` does and however the threads are scheduled
+    // (with an unbounded channel, a slow `progress` or a starved calling thread let the
+    // workers finish the whole batch before a Ctrl-C was seen).
     let stop = AtomicBool::new(false);
-    let (sender, receiver) = mpsc::channel::<Record>();
+    let (sender, receiver) = mpsc::sync_channel::<Record>(options.jobs);
     // A receiver is not Sync; the lock only lets the wait run without the GIL.
     let receiver = Mutex::new(receiver);
     let mut interrupted: Option<PyErr> = None;

@@ -190,9 +190,13 @@ def batch(
     ``OUT_DIR/atlas-skin-batch.jsonl``). The method's options as ``compute_weights``.
 
     ``progress`` is called on the calling thread with each record as its file finishes
-    (for a progress bar). An exception from it, or Ctrl-C (``KeyboardInterrupt``), stops
-    the batch: the files running finish (their outputs complete), the others are not
-    started and are logged as ``"cancelled"``, then the exception is raised.
+    (for a progress bar); a worker that finishes a file waits while ``jobs`` records are
+    not yet taken. An exception from it, or Ctrl-C (``KeyboardInterrupt``), stops the
+    batch within a few files: the files running finish (their outputs complete), the
+    others are not started and are logged as ``"cancelled"``, then the exception is
+    raised. (A Python started with SIGINT ignored, as a background job of a
+    non-interactive shell is, does not turn Ctrl-C into ``KeyboardInterrupt``: call
+    ``signal.signal(signal.SIGINT, signal.default_int_handler)`` first.)
 
     Returns ``{"records": [...], "summary": {...}}``: one record per file, in the order
     of the inputs (``input``, ``output``, ``status``: ``"ok"``, ``"failed"`` or
