@@ -6,6 +6,7 @@ import subprocess
 import sys
 import time
 
+import numpy as np
 import pytest
 
 import atlas_skin
@@ -172,3 +173,61 @@ def test_a_python_that_ignores_sigint_finishes_its_batch(tmp_path):
     assert returncode == 0, stderr
     statuses = [json.loads(line)["status"] for line in log.read_text().splitlines()]
     assert statuses == ["ok"] * 4
+
+
+def test_skin_file_with_a_gate_raises_quality_gate_error(tmp_path):
+    source = data("bench/rignet-val/1168.glb")
+    with pytest.raises(atlas_skin.QualityGateError) as caught:
+        atlas_skin.skin_file(source, tmp_path / "out.glb", report=tmp_path / "out.json", fail_on="soft-joints")
+    error = caught.value
+    assert error.reasons and all(r.startswith("soft-joints: ") for r in error.reasons)
+    assert error.report["quality"]["rejected"] and error.report["quality"]["fail_on"] == ["soft-joints"]
+    assert error.output is None
+    assert "the quality gate rejected" in str(error) and str(source) in str(error)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.rejected.json"]
+
+    with pytest.raises(atlas_skin.QualityGateError) as caught:
+        atlas_skin.skin_file(source, tmp_path / "out.glb", fail_on=["placement", "unweighted-joints"], keep_rejected=True)
+    assert caught.value.output == str(tmp_path / "out.rejected.glb")
+    assert all(r.startswith("unweighted-joints: ") for r in caught.value.reasons)
+    kept = atlas_skin.load(caught.value.output)
+    assert kept["weights"] is not None
+    assert not (tmp_path / "out.glb").exists()
+
+    report = atlas_skin.skin_file(source, tmp_path / "out.glb", fail_on=["placement", "mesh"])
+    assert not report["quality"]["rejected"] and report["quality"]["reasons"] == []
+    assert (tmp_path / "out.glb").is_file() and not (tmp_path / "out.rejected.glb").exists()
+    with pytest.raises(ValueError, match="not a condition of the quality gate"):
+        atlas_skin.skin_file(source, tmp_path / "out.glb", fail_on=["soft-joint"])
+    with pytest.raises(TypeError, match="fail_on"):
+        atlas_skin.skin_file(source, tmp_path / "out.glb", fail_on=3)
+
+
+def test_a_batch_with_a_gate_records_rejected_files(tmp_path):
+    inputs = [data("models/riggedsimple/RiggedSimple.glb"), data("bench/rignet-val/1168.glb")]
+    result = atlas_skin.batch(inputs, tmp_path / "out", jobs=2, fail_on="soft-joints", keep_rejected=True)
+    by_name = {r["input"].split("/")[-1]: r for r in result["records"]}
+    assert by_name["RiggedSimple.glb"]["status"] == "ok" and by_name["RiggedSimple.glb"]["reasons"] == []
+    rejected = by_name["1168.glb"]
+    assert rejected["status"] == "rejected" and rejected["reasons"][0].startswith("soft-joints: ")
+    assert rejected["kept"] == str(tmp_path / "out" / "1168.rejected.glb")
+    assert result["summary"]["rejected"] == 1 and result["summary"]["ok"] == 1
+
+
+def test_compute_weights_with_a_gate(demo):
+    """The demo is clean; with a stored vertex no triangle uses, `fallback` rejects it."""
+    arrays = (demo["positions"], demo["triangles"], demo["joint_positions"], demo["parents"])
+    options = dict(names=demo["names"], inverse_bind=demo["inverse_bind"])
+    _, _, report = atlas_skin.compute_weights(*arrays, fail_on=["warnings", "fallback"], **options)
+    assert report["quality"] == {
+        "fail_on": ["warnings", "fallback"],
+        "reasons": [],
+        "rejected": False,
+        "soft_joints_without_weight": [],
+        "unweighted_joints": [],
+    }
+    positions = np.vstack([demo["positions"], [[0.0, 1.0, 0.5]]])
+    with pytest.raises(atlas_skin.QualityGateError) as caught:
+        atlas_skin.compute_weights(positions, *arrays[1:], fail_on="fallback", **options)
+    assert caught.value.reasons == ["fallback: 1 vertices weighted by a fallback"]
+    assert caught.value.report["warning_topics"] == ["mesh"]

@@ -29,6 +29,7 @@ pub mod report;
 pub mod rows;
 pub mod skeleton;
 pub mod tolerance;
+pub mod warning;
 pub mod weights;
 
 pub use decompose::{decompose, DecomposeError, DecomposeParams};
@@ -37,3 +38,4 @@ pub use decomposition::{
 };
 pub use mesh::{weld, MeshStats, SurfaceMesh, Topology, Welded};
 pub use pipeline::{skin, SkinError, SkinInput, SkinParams, Skinned};
+pub use warning::{Warning, WarningTopic};
