@@ -17,7 +17,7 @@ use glam::{Mat3, Quat, Vec3};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use support::{atlas_skin_ok, obj_positions, out_dir};
+use support::{atlas_skin_ok, eval_json, obj_positions, out_dir};
 
 /// The workspace's folder.
 fn workspace() -> PathBuf {
@@ -188,12 +188,6 @@ fn eval_takes_a_blender_bone_heat_export_as_it_takes_one_with_matching_names() {
     // Bone heat is not the artist's weighting: real, finite differences.
     let max = with_blender_names["deform_random"]["max"].as_f64().unwrap();
     assert!(max > 1e-3 && max < 0.5, "{max}");
-}
-
-/// `eval --json REFERENCE CANDIDATE`, parsed.
-fn eval_json(reference: &Path, candidate: &Path) -> Value {
-    let output = atlas_skin_ok(&[Path::new("eval"), reference, candidate, Path::new("--json")]);
-    serde_json::from_slice(&output.stdout).expect("eval's JSON")
 }
 
 /// The KayKit knight's FBX (metres, +Y up) exported by Blender's glTF exporter as a glb in

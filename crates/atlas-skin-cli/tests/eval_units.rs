@@ -8,15 +8,9 @@
 mod support;
 
 use atlas_skin_corpus::data_file;
-use serde_json::Value;
 use std::path::Path;
 use std::process::Command;
-use support::{atlas_skin, atlas_skin_ok, out_dir};
-
-fn eval_json(reference: &Path, candidate: &Path) -> Value {
-    let output = atlas_skin_ok(&[Path::new("eval"), reference, candidate, Path::new("--json")]);
-    serde_json::from_slice(&output.stdout).expect("eval's JSON")
-}
+use support::{atlas_skin, atlas_skin_ok, eval_json, out_dir};
 
 #[test]
 fn eval_fits_an_assimp_conversion_in_the_files_centimetres() {
