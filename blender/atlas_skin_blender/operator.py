@@ -11,6 +11,28 @@ from .options import OptionError, bone_factors, bone_list
 from .package import MissingPackage, atlas_skin
 from .rig import RigError, deforming_rig
 
+# The quality gate's conditions of `atlas_skin.compute_weights(fail_on=...)` that a mesh in
+# Blender can meet (a Blender mesh has no file reader's warnings): the option's items.
+FAIL_ON = (
+    ("WARNINGS", "Any Warning", "Any warning of the method"),
+    ("MESH", "Mesh", "A warning about the mesh: duplicate faces, pieces wound inside out, a "
+     "surface joining the sides of cuts, loose vertices"),
+    ("PLACEMENT", "Placement", "A warning about where the bones sit in the mesh: beside it or "
+     "outside its surface, at one point, zero-length, no boundary at all"),
+    ("SKELETON", "Skeleton", "A warning about what the method made of the bones: a hierarchy "
+     "inferred, leaf extensions capped, bones named as helpers"),
+    ("WEIGHTS", "Weights", "A warning about the weights: soft bones without weight"),
+    ("FALLBACK", "Fallback", "A vertex weighted by a fallback (a loose vertex: its nearest bone)"),
+    ("SOFT_JOINTS", "Soft Bones Without Weight",
+     "A bone whose soft boundary found no cross-section and that carries no weight"),
+    ("UNWEIGHTED_JOINTS", "Bones Without Weight",
+     "A bone given a boundary that carries no weight"),
+)
+
+
+class Rejected(Exception):
+    """The quality gate (the Fail On option) refused the weights (the message says why)."""
+
 
 def selection(context):
     """(armature, meshes) of the selection, or a sentence saying what is missing."""
@@ -85,6 +107,14 @@ class OBJECT_OT_parent_atlas_skin(bpy.types.Operator):
         description="Bones that get no boundary: their part moves with their parent's "
         "(comma-separated)",
     )
+    fail_on: EnumProperty(
+        name="Fail On",
+        description="Refuse to weight, leaving the meshes unchanged, when the result has one of "
+        "these (atlas-skin's quality gate, --fail-on)",
+        items=FAIL_ON,
+        options={"ENUM_FLAG"},
+        default=set(),
+    )
     use_tails: BoolProperty(
         name="Bone Tails",
         description="Leaf bones end at their tails; off, "
@@ -112,7 +142,7 @@ class OBJECT_OT_parent_atlas_skin(bpy.types.Operator):
             summary, warnings = self.parent_with_weights(
                 context, armature, meshes, lambda: manager.progress_update(next(steps))
             )
-        except (MissingPackage, RigError, BodyError, OptionError, ValueError) as error:
+        except (MissingPackage, RigError, BodyError, OptionError, Rejected, ValueError) as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         finally:
@@ -131,15 +161,18 @@ class OBJECT_OT_parent_atlas_skin(bpy.types.Operator):
         with rest_state(armature, meshes):
             body = read_body(context.evaluated_depsgraph_get(), armature, meshes, progress)
             start = time.perf_counter()
-            indices, weights, report = package.compute_weights(
-                body.positions,
-                body.triangles,
-                rig.heads,
-                rig.parents,
-                tails=rig.tails if self.use_tails else None,
-                inverse_bind=rig.inverse_bind,
-                **options,
-            )
+            try:
+                indices, weights, report = package.compute_weights(
+                    body.positions,
+                    body.triangles,
+                    rig.heads,
+                    rig.parents,
+                    tails=rig.tails if self.use_tails else None,
+                    inverse_bind=rig.inverse_bind,
+                    **options,
+                )
+            except package.QualityGateError as error:
+                raise Rejected("Fail On: " + "; ".join(error.reasons)) from None
             seconds = time.perf_counter() - start
             progress()
             for obj, first, end in body.ranges:
@@ -163,6 +196,7 @@ class OBJECT_OT_parent_atlas_skin(bpy.types.Operator):
             "binding": self.binding.lower(),
             "force": bone_list(self.force, bone_names, "Force Boundaries"),
             "forbid": bone_list(self.forbid, bone_names, "Forbid Boundaries"),
+            "fail_on": sorted(c.lower().replace("_", "-") for c in self.fail_on),
         }
 
 

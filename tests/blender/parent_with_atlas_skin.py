@@ -233,6 +233,31 @@ def check_errors(path):
           "no atlas_skin package, no deforming bone: refused, scene unchanged")
 
 
+def check_quality_gate(path):
+    """Fail On (the quality gate): the demo, clean, is weighted whatever the conditions; with
+    a loose vertex (weighted by the nearest-bone fallback), Fallback refuses it with the
+    reason and the scene unchanged, while conditions it does not meet let it through."""
+    from bl_ext.user_default.atlas_skin_blender.operator import FAIL_ON
+
+    armature, meshes = import_character(path)
+    strip_weights(meshes)
+    every = {item[0] for item in FAIL_ON}
+    assert run_operator(armature, meshes, fail_on=every) == {"FINISHED"}
+    strip_weights(meshes)
+    body = meshes[0].data
+    body.vertices.add(1)
+    body.vertices[-1].co = (0.0, 0.0, 1.0)
+    body.update()
+    expect_error(armature, meshes, "Fail On: fallback: 1 vertices weighted by a fallback",
+                 fail_on={"FALLBACK"})
+    expect_error(armature, meshes, "Fail On: mesh: 1 stored vertices are used by no triangle",
+                 fail_on={"MESH", "PLACEMENT"})
+    assert run_operator(armature, meshes, fail_on={"PLACEMENT", "SKELETON"}) == {"FINISHED"}
+    check_groups("demo with a loose vertex", meshes, deforming_names(armature))
+    print("fail on: the demo weighted under every condition; with a loose vertex refused by "
+          "Fallback and Mesh, scene unchanged; weighted under Placement and Skeleton")
+
+
 def check_modifiers(path):
     """A mesh is read with its modifiers, as Blender's binding reads it; modifiers that
     change the vertex count are left out, with a warning."""
@@ -396,6 +421,7 @@ def main():
     check_options(demo)
     check_tails(knight)
     check_errors(demo)
+    check_quality_gate(demo)
     check_modifiers(demo)
     render_screenshot(
         os.path.join(OUT, "blender-addon.png"),

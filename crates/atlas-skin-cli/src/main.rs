@@ -3,6 +3,7 @@
 mod cmd;
 mod counts;
 mod input;
+mod quality_gate;
 mod skinning_data;
 
 use clap::{Parser, Subcommand};
@@ -69,7 +70,10 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
             eprintln!("error: {error:#}");
-            ExitCode::FAILURE
+            match error.downcast_ref::<quality_gate::Rejected>() {
+                Some(_) => ExitCode::from(quality_gate::EXIT_REJECTED),
+                None => ExitCode::FAILURE,
+            }
         }
     }
 }

@@ -17,7 +17,7 @@ use glam::{Mat3, Quat, Vec3};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use support::{atlas_skin_ok, obj_positions, out_dir};
+use support::{atlas_skin_ok, eval_json, obj_positions, out_dir};
 
 /// The workspace's folder.
 fn workspace() -> PathBuf {
@@ -188,4 +188,29 @@ fn eval_takes_a_blender_bone_heat_export_as_it_takes_one_with_matching_names() {
     // Bone heat is not the artist's weighting: real, finite differences.
     let max = with_blender_names["deform_random"]["max"].as_f64().unwrap();
     assert!(max > 1e-3 && max < 0.5, "{max}");
+}
+
+/// The KayKit knight's FBX (metres, +Y up) exported by Blender's glTF exporter as a glb in
+/// metres, +Y up and +Z up (the exporter's "+Y Up" off): `eval` matches the first as
+/// stored and fits the second (a quarter turn, scale 1), both with 0 error (below 1e-6).
+#[test]
+fn eval_fits_a_blender_export_in_other_axes() {
+    let dir = out_dir("blender-eval-axes");
+    let input = data_file("fbx/KayKit_Knight.fbx");
+    for (flag, turn) in [(None, None), (Some("--z-up"), Some("z_up_to_y_up"))] {
+        let glb = dir.join(format!("knight{}.glb", flag.unwrap_or("")));
+        let mut args = vec![input.as_path(), glb.as_path()];
+        args.extend(flag.map(Path::new));
+        run_blender("export_glb.py", &args);
+        let e = eval_json(&input, &glb);
+        assert_eq!(e["matched"], e["vertices"], "{flag:?}");
+        assert_eq!(e["fit"]["turn"].as_str(), turn, "{flag:?}: {}", e["fit"]);
+        if turn.is_some() {
+            assert!((e["fit"]["scale"].as_f64().unwrap() - 1.0).abs() < 1e-6);
+        }
+        // Equal weights: Blender stores them in float32, the FBX in float64.
+        for figure in [&e["weights_l1"]["max"], &e["deform_random"]["max"]] {
+            assert!(figure.as_f64().unwrap() < 1e-6, "{flag:?}: {figure}");
+        }
+    }
 }

@@ -10,15 +10,15 @@ use support::{atlas_skin, atlas_skin_ok};
 
 /// A unit square of 4 vertices (2 triangles) skinned to two joints, "root" and "tip".
 fn square_glb(joints: [[u8; 4]; 4], weights: [[f32; 4]; 4]) -> Vec<u8> {
-    square_glb_at(0.0, joints, weights)
+    rectangle_glb(0.0, 1.0, joints, weights)
 }
 
-/// [`square_glb`] moved by `dx` along X.
-fn square_glb_at(dx: f32, joints: [[u8; 4]; 4], weights: [[f32; 4]; 4]) -> Vec<u8> {
+/// [`square_glb`] `width` wide along X, moved by `dx` along X.
+fn rectangle_glb(dx: f32, width: f32, joints: [[u8; 4]; 4], weights: [[f32; 4]; 4]) -> Vec<u8> {
     let positions: [[f32; 3]; 4] = [
         [dx, 0.0, 0.0],
-        [1.0 + dx, 0.0, 0.0],
-        [1.0 + dx, 1.0, 0.0],
+        [width + dx, 0.0, 0.0],
+        [width + dx, 1.0, 0.0],
         [dx, 1.0, 0.0],
     ];
     let indices: [u16; 6] = [0, 1, 2, 0, 2, 3];
@@ -181,15 +181,30 @@ fn identical_crafted_files_give_zeros() {
     assert_eq!(e["bleeding"]["fraction"].as_f64(), Some(0.0));
 }
 
+/// The same square moved is fitted back (a translation, said in the output); a
+/// rectangle is another mesh, which no fit pairs: refused.
 #[test]
 fn a_candidate_of_another_mesh_is_refused() {
     let weights = [[1.0, 0.0, 0.0, 0.0]; 4];
     let reference = write("eval_crafted_here.glb", &square_glb([[0; 4]; 4], weights));
     let elsewhere = write(
         "eval_crafted_elsewhere.glb",
-        &square_glb_at(5.0, [[0; 4]; 4], weights),
+        &rectangle_glb(5.0, 1.0, [[0; 4]; 4], weights),
     );
-    let output = eval(&reference, &elsewhere);
+    let moved = eval_json(&reference, &elsewhere);
+    let fit = &moved["fit"];
+    assert_eq!(
+        (&fit["turn"], &fit["scale"]),
+        (&json!("none"), &json!(1.0)),
+        "{fit}"
+    );
+    assert_eq!(fit["translation"], json!([-5.0, 0.0, 0.0]), "{fit}");
+    assert_eq!(moved["weights_l1"]["max"], 0.0);
+    let other = write(
+        "eval_crafted_other.glb",
+        &rectangle_glb(5.0, 3.0, [[0; 4]; 4], weights),
+    );
+    let output = eval(&reference, &other);
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(!output.status.success());
     assert!(stderr.contains("not the same mesh?"), "{stderr}");

@@ -4,11 +4,13 @@
 //!
 //! The metrics follow the definitions of `shared/data/BASELINES.md` so that figures are
 //! comparable with the other tools' rows there. Candidate vertices are matched to the
-//! reference's by position ([`matching`]); every metric is then computed over the
+//! reference's by position ([`matching`]), after fitting the candidate's units and axes
+//! onto the reference's when fewer than half pair as stored ([`fit`]); every metric is then computed over the
 //! reference's stored vertices that found a match, with the reference skeleton.
 
 pub mod bleeding;
 pub mod deform;
+pub mod fit;
 pub mod matching;
 pub mod rignet_metrics;
 pub mod validity;
@@ -17,6 +19,7 @@ pub mod worst;
 
 pub use bleeding::Bleeding;
 pub use deform::{DeformError, Skinning};
+pub use fit::{AxisTurn, Fit, FitSource};
 pub use rignet_metrics::RigNetMetrics;
 pub use validity::Validity;
 pub use weights_l1::WeightsL1;
@@ -61,7 +64,7 @@ pub enum EvalError {
     RigJointCount { rig: usize, skeleton: usize },
     #[error("the reference mesh has no extent (bounding-box diagonal 0)")]
     DegenerateMesh,
-    #[error("no reference vertex has a candidate vertex within {tolerance:.3e} of its position: not the same mesh?")]
+    #[error("no reference vertex has a candidate vertex within {tolerance:.3e} of its position, as stored or after fitting a uniform scale, a Y-up/Z-up turn and a translation from the meshes' and the skeletons' bounding boxes: not the same mesh?")]
     NoVertexMatched { tolerance: f64 },
 }
 
@@ -152,6 +155,10 @@ pub struct Evaluation {
     pub joints: usize,
     /// Reference vertices that found a candidate vertex at their position.
     pub matched: usize,
+    /// The candidate's units and axes fitted onto the reference's before matching its
+    /// vertices ([`fit`]); `None`: matched as stored (and in JSON written before fits).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fit: Option<Fit>,
     pub candidate_vertices: usize,
     pub candidate_joints: usize,
     /// How each candidate joint was matched to a reference joint, in candidate order
@@ -242,6 +249,7 @@ pub fn evaluate(input: &EvalInput, options: &EvalOptions) -> Result<Evaluation, 
         candidate_vertices: candidate.positions.len(),
         candidate_joints: candidate.skeleton.len(),
         joint_matches: aligned.joint_matches,
+        fit: aligned.fit,
         weights_l1: weights_l1::weights_l1(&aligned.reference, &aligned.candidate, joints),
         rignet: Some(rignet_metrics::rignet_metrics(
             &aligned.reference_as_stored,
@@ -305,6 +313,9 @@ struct Aligned {
     reference_stored: VertexWeights,
     /// The reference joint of every candidate joint and how it was found.
     joint_matches: Vec<matching::JointPair>,
+    /// The fit of the candidate onto the reference, when its positions as stored paired
+    /// fewer than half of the compared vertices.
+    fit: Option<Fit>,
 }
 
 /// Matches the candidate's vertices and joints to the reference's and lines up their rows.
@@ -332,8 +343,44 @@ fn align(input: &EvalInput, options: &EvalOptions, diagonal: f64) -> Result<Alig
         .collect();
     let compared_positions: Vec<Vec3> = compared.iter().map(|&v| reference.positions[v]).collect();
     let tolerance = options.match_tolerance * diagonal;
-    let candidate_of =
+    let mut candidate_of =
         matching::match_vertices(&compared_positions, candidate.positions, tolerance);
+    let paired = |of: &[u32]| of.iter().filter(|&&c| c != matching::UNMATCHED).count();
+    let mut fit = None;
+    let as_stored = paired(&candidate_of);
+    if 2 * as_stored < compared.len() {
+        // Other units or axes: fit them from the boxes of the meshes or of the joints
+        // paired by name (never by position, which assumes the same units).
+        let joint_of_candidate_index: Vec<(usize, usize)> = joint_of_candidate
+            .iter()
+            .enumerate()
+            .filter(|&(k, _)| joint_matches[k].how != matching::JointMatch::Position)
+            .map(|(k, &j)| (j as usize, k))
+            .collect();
+        let reference_joints: Vec<Vec3> = joint_of_candidate_index
+            .iter()
+            .map(|&(j, _)| reference_at[j])
+            .collect();
+        let candidate_joints: Vec<Vec3> = joint_of_candidate_index
+            .iter()
+            .map(|&(_, k)| candidate_at[k])
+            .collect();
+        let best = fit::best_fit(
+            fit::Side {
+                positions: &compared_positions,
+                named_joints: &reference_joints,
+            },
+            fit::Side {
+                positions: candidate.positions,
+                named_joints: &candidate_joints,
+            },
+            tolerance,
+        );
+        if let Some((found, of)) = best.filter(|(_, of)| paired(of) > as_stored) {
+            fit = Some(found);
+            candidate_of = of;
+        }
+    }
     let pairs: Vec<(usize, usize)> = compared
         .iter()
         .zip(&candidate_of)
@@ -364,6 +411,7 @@ fn align(input: &EvalInput, options: &EvalOptions, diagonal: f64) -> Result<Alig
         surface_of_row: pairs.iter().map(|&(r, _)| surface_of_stored[r]).collect(),
         reference_stored,
         joint_matches,
+        fit,
     })
 }
 

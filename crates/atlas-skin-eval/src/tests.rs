@@ -220,7 +220,26 @@ fn inputs_that_cannot_be_compared_are_errors() {
         &[Vec3::ZERO, Vec3::new(2.0, 5.0, 0.0)],
     )
     .unwrap();
+    // Moved away: fitted back (a translation), every vertex paired.
     let far: Vec<Vec3> = f.positions.iter().map(|p| *p + Vec3::splat(10.0)).collect();
+    let moved = run(
+        &f,
+        Weighted {
+            positions: &far,
+            skeleton: &f.skeleton,
+            weights: &f.weights,
+        },
+    )
+    .unwrap();
+    let fit = moved.fit.expect("a fit");
+    assert_relative_eq!(fit.translation[0], -10.0, epsilon = 1e-5);
+    assert_eq!((moved.matched, moved.weights_l1.max), (30, 0.0));
+    // Another shape: no fit pairs a vertex.
+    let other_shape: Vec<Vec3> = f
+        .positions
+        .iter()
+        .map(|p| Vec3::new(p.y, 3.0 * p.x, -p.z) + Vec3::splat(10.0))
+        .collect();
     let short = VertexWeights::from_rows([[(0u32, 1.0f32)]]);
     let out_of_range = VertexWeights::from_rows(f.positions.iter().map(|_| [(2u32, 1.0f32)]));
     type Expected = fn(&EvalError) -> bool;
@@ -235,7 +254,7 @@ fn inputs_that_cannot_be_compared_are_errors() {
         ),
         (
             Weighted {
-                positions: &far,
+                positions: &other_shape,
                 skeleton: &f.skeleton,
                 weights: &f.weights,
             },

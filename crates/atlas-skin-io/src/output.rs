@@ -69,15 +69,38 @@ impl OutputPlan {
     /// Those of [`OutputPlan::new`], checked again; [`IoError::Write`] when `out` was not
     /// planned or the file cannot be written.
     pub fn write(&self, out: &Path, bytes: &[u8]) -> Result<(), IoError> {
-        let write_error = |cause| IoError::Write {
+        self.check_planned(out)?;
+        write_atomically(out, bytes).map_err(|cause| IoError::Write {
             path: out.to_path_buf(),
             cause,
-        };
+        })
+    }
+
+    /// Removes the file at the planned output `out`, if any: an earlier run's output that
+    /// this run replaces by nothing (a result the quality gate rejected). Nothing there is
+    /// fine; a link is removed, not its target.
+    ///
+    /// # Errors
+    /// Those of [`OutputPlan::write`], [`IoError::Write`] when the file cannot be removed.
+    pub fn remove(&self, out: &Path) -> Result<(), IoError> {
+        self.check_planned(out)?;
+        match std::fs::remove_file(out) {
+            Err(cause) if cause.kind() != std::io::ErrorKind::NotFound => Err(IoError::Write {
+                path: out.to_path_buf(),
+                cause,
+            }),
+            _ => Ok(()),
+        }
+    }
+
+    /// `out` is a planned output, still no input, and no folder, device, FIFO or socket.
+    fn check_planned(&self, out: &Path) -> Result<(), IoError> {
         let resolved = resolve(out);
         if !self.outputs.iter().any(|(_, r)| *r == resolved) {
-            return Err(write_error(std::io::Error::other(
-                "not one of the command's planned outputs",
-            )));
+            return Err(IoError::Write {
+                path: out.to_path_buf(),
+                cause: std::io::Error::other("not one of the command's planned outputs"),
+            });
         }
         if let Some((input, _)) = self.inputs.iter().find(|(_, r)| *r == resolved) {
             return Err(IoError::WouldOverwriteInput {
@@ -85,8 +108,7 @@ impl OutputPlan {
                 input: input.clone(),
             });
         }
-        check_target(out)?;
-        write_atomically(out, bytes).map_err(write_error)
+        check_target(out)
     }
 }
 
@@ -280,5 +302,39 @@ mod tests {
         let other = dir.join("other.bin");
         assert!(plan.write(&other, b"x").is_err(), "an unplanned output");
         assert!(!other.exists());
+    }
+
+    #[test]
+    fn removals_take_only_planned_regular_files() {
+        let dir = scratch("remove");
+        let (out, missing, input) = (
+            dir.join("out.glb"),
+            dir.join("missing.glb"),
+            dir.join("in.glb"),
+        );
+        std::fs::write(&out, b"earlier").unwrap();
+        std::fs::write(&input, b"input").unwrap();
+        let folder = dir.join("folder.glb");
+        std::fs::create_dir(&folder).unwrap();
+        let (link, target) = (dir.join("link.glb"), dir.join("target.txt"));
+        std::fs::write(&target, b"target").unwrap();
+        std::os::unix::fs::symlink(&target, &link).unwrap();
+        let plan = OutputPlan::new(
+            [input.as_path()],
+            [out.as_path(), missing.as_path(), link.as_path()],
+        )
+        .unwrap();
+        plan.remove(&out).unwrap();
+        plan.remove(&missing).unwrap();
+        assert!(!out.exists());
+        plan.remove(&link).unwrap();
+        assert!(
+            !link.exists() && target.exists(),
+            "the link goes, not its target"
+        );
+        assert!(plan.remove(&input).is_err(), "an input is not planned");
+        assert!(plan.remove(&folder).is_err(), "an unplanned folder");
+        assert_eq!(std::fs::read(&input).unwrap(), b"input");
+        assert!(folder.is_dir());
     }
 }

@@ -6,7 +6,10 @@
 //! the files whose outputs exist and are newer than the file (and the settings file).
 //! Every finished file appends one JSON record to the log (flushed at once, so a killed
 //! batch keeps the records of what it finished); the outputs themselves are written as
-//! `skin` writes them, complete or not at all.
+//! `skin` writes them, complete or not at all. With a quality gate (the settings'
+//! `fail_on`), a file the gate refuses is recorded as [`Status::Rejected`] with the
+//! reasons, its outputs kept under their rejected names or not written
+//! ([`crate::job`]).
 
 use crate::job::{error_chain, Input, Outputs, SkinJob};
 use crate::settings::Settings;
@@ -84,6 +87,9 @@ pub struct BatchOptions {
     pub html: bool,
     /// The JSON-lines log; `None`: [`DEFAULT_LOG_NAME`] in `out_dir`.
     pub log: Option<PathBuf>,
+    /// Write the outputs of the files the quality gate rejects, under their rejected
+    /// names ([`crate::quality::rejected_name`]: `<name>.rejected.glb`).
+    pub keep_rejected: bool,
     /// The method's settings, the same for every file.
     pub settings: Settings,
 }
@@ -109,6 +115,8 @@ pub enum Status {
     Skipped,
     /// Not started: the batch was stopped (see [`run_batch`]'s `stop`).
     Cancelled,
+    /// Skinned, and refused by the quality gate: see the record's reasons.
+    Rejected,
 }
 
 /// One line of the log.
@@ -121,6 +129,10 @@ pub struct Record {
     pub status: Status,
     /// The message `skin` would print, for a failed file.
     pub error: Option<String>,
+    /// Why the quality gate rejected the file (empty otherwise).
+    pub reasons: Vec<String>,
+    /// The skinned glb of a rejected file, kept under its rejected name.
+    pub kept: Option<String>,
     /// Wall time of the whole job (reading, skinning, writing), in seconds.
     pub seconds: f64,
     /// The report's `timings_ms` (stages and writing), for a skinned file.
@@ -139,6 +151,7 @@ pub struct Summary {
     pub failed: usize,
     pub skipped: usize,
     pub cancelled: usize,
+    pub rejected: usize,
     /// Wall time of the batch, in seconds.
     pub seconds: f64,
     /// Skinned files per second of wall time.
@@ -148,7 +161,7 @@ pub struct Summary {
 
 impl std::fmt::Display for Summary {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        if self.ok == 0 && self.failed == 0 && self.cancelled == 0 {
+        if self.ok == 0 && self.failed == 0 && self.cancelled == 0 && self.rejected == 0 {
             return write!(
                 f,
                 "nothing to do: the outputs of all {} files are up to date",
@@ -159,9 +172,13 @@ impl std::fmt::Display for Summary {
             0 => String::new(),
             n => format!(", {n} cancelled"),
         };
+        let rejected = match self.rejected {
+            0 => String::new(),
+            n => format!(", {n} rejected"),
+        };
         write!(
             f,
-            "{} file{}: {} skinned, {} failed, {} up to date{cancelled}, in {:.1} s ({:.2} characters/s); log: {}",
+            "{} file{}: {} skinned, {} failed, {} up to date{cancelled}{rejected}, in {:.1} s ({:.2} characters/s); log: {}",
             self.files,
             if self.files == 1 { "" } else { "s" },
             self.ok,
@@ -272,6 +289,7 @@ pub fn plan_jobs(inputs: &[PathBuf], options: &BatchOptions) -> Result<Vec<SkinJ
             },
             // The log's timings, counts and warnings come from the report.
             keep_report: true,
+            keep_rejected: options.keep_rejected,
         });
     }
     Ok(jobs)
@@ -312,6 +330,8 @@ fn run_one(job: &SkinJob, resume: bool, stop: &AtomicBool) -> Record {
         output: job.outputs.glb.to_string_lossy().into_owned(),
         status: Status::Skipped,
         error: None,
+        reasons: Vec::new(),
+        kept: None,
         seconds: 0.0,
         timings_ms: None,
         counts: None,
@@ -322,12 +342,11 @@ fn run_one(job: &SkinJob, resume: bool, stop: &AtomicBool) -> Record {
         return record;
     }
     if resume {
-        // Files a killed run was writing when it stopped.
+        // Files a killed run was writing when it stopped (under either name).
         let outputs = &job.outputs;
-        std::iter::once(&outputs.glb)
-            .chain(outputs.report.iter())
-            .chain(outputs.html.iter())
-            .chain(outputs.debug_glb.iter())
+        outputs
+            .paths()
+            .chain(outputs.rejected_names().paths())
             .for_each(|out| {
                 atlas_skin_io::remove_leftover_temporaries(out);
             });
@@ -338,7 +357,13 @@ fn run_one(job: &SkinJob, resume: bool, stop: &AtomicBool) -> Record {
     match job.run(&mut |_| {}) {
         Ok(outcome) => {
             let mut report = outcome.report.unwrap_or_default();
-            record.status = Status::Ok;
+            record.status = if outcome.verdict.rejected() {
+                Status::Rejected
+            } else {
+                Status::Ok
+            };
+            record.reasons = outcome.verdict.reasons;
+            record.kept = outcome.kept.map(|p| p.to_string_lossy().into_owned());
             record.timings_ms = Some(report["timings_ms"].take());
             record.counts = Some(report["counts"].take());
             record.warnings = serde_json::from_value(report["warnings"].take()).unwrap_or_default();
@@ -417,6 +442,7 @@ pub fn run_batch(
         failed: count(Status::Failed),
         skipped: count(Status::Skipped),
         cancelled: count(Status::Cancelled),
+        rejected: count(Status::Rejected),
         seconds,
         characters_per_second: count(Status::Ok) as f64 / seconds.max(1e-9),
         log: log_path,

@@ -3,12 +3,21 @@
 //! blended weights), write the skinned glTF binary and, when asked, the JSON report, the
 //! HTML report, a debug view and RigNet's rig_info text. Every output goes through one
 //! [`OutputPlan`], checked before any work: complete or untouched, never over an input.
+//!
+//! With a quality gate ([`crate::quality`], `Settings::fail_on`), a rejected character's
+//! outputs are written only when asked ([`SkinJob::keep_rejected`]), under their rejected
+//! names ([`rejected_name`]); its JSON report always, under its rejected name. Of the
+//! outputs' names and their rejected names, a gated run leaves only the files it wrote:
+//! an earlier run's file under the other name is removed, so that a folder's `*.glb`
+//! hold accepted characters only.
 
 use crate::html::{write_html, HtmlError};
+use crate::quality::{rejected_name, Findings, Verdict};
 use crate::report::{stage_timings, SkinReport};
 use crate::settings::{Settings, SettingsError};
 use atlas_skin::pipeline::{skin, SkinError, SkinInput, Skinned};
 use atlas_skin::report::{debug_colors, debug_lines};
+use atlas_skin::Warning;
 use atlas_skin_io::gltf::{debug_glb, skinned_glb_taking_document, WriteOptions};
 use atlas_skin_io::{Character, Contents, IoError, LoadOptions, OutputPlan, TriangleMesh};
 use glam::Vec3;
@@ -144,6 +153,18 @@ impl Outputs {
         }
     }
 
+    /// The same outputs under their rejected names ([`rejected_name`]).
+    pub fn rejected_names(&self) -> Self {
+        let rename = |path: &PathBuf| rejected_name(path);
+        Self {
+            glb: rename(&self.glb),
+            report: self.report.as_ref().map(rename),
+            html: self.html.as_ref().map(rename),
+            debug_glb: self.debug_glb.as_ref().map(rename),
+            rig_info: self.rig_info.as_ref().map(rename),
+        }
+    }
+
     /// Every file written.
     pub fn paths(&self) -> impl Iterator<Item = &Path> {
         [
@@ -169,6 +190,9 @@ pub struct SkinJob {
     /// without it the report is built only for [`Outputs::report`] (serialised straight
     /// to its file) and [`Outputs::html`] (as values).
     pub keep_report: bool,
+    /// When the quality gate rejects the character, write all its outputs anyway, under
+    /// their rejected names ([`rejected_name`]); otherwise only its JSON report is.
+    pub keep_rejected: bool,
 }
 
 /// What a finished job tells its caller.
@@ -178,19 +202,27 @@ pub struct JobOutcome {
     /// report needed it. (The file of [`Outputs::report`] is serialised without them.)
     pub report: Option<Value>,
     /// What the method noticed and handled (the report's warnings also hold the reader's).
-    pub method_warnings: Vec<String>,
+    pub method_warnings: Vec<Warning>,
     /// One line: input, vertices, joints (cut, soft, skipped), regions, output.
     pub summary: String,
+    /// The quality gate's verdict (without a gate: accepted).
+    pub verdict: Verdict,
+    /// The skinned glb of a rejected character, written under its rejected name when
+    /// [`SkinJob::keep_rejected`] asked for it.
+    pub kept: Option<PathBuf>,
 }
 
 impl SkinJob {
     /// Runs the job (see the module documentation). `progress` is told each step as it
     /// starts: the method's stages by name, then `writing`.
     pub fn run(&self, progress: &mut dyn FnMut(&'static str)) -> Result<JobOutcome, JobError> {
-        let outputs = &self.outputs;
+        let fail_on = self.settings.fail_on()?;
+        let rejected_outputs = (!fail_on.is_empty()).then(|| self.outputs.rejected_names());
         let plan = OutputPlan::new(
             self.input.paths().chain(self.settings.paths()),
-            outputs.paths(),
+            self.outputs
+                .paths()
+                .chain(rejected_outputs.iter().flat_map(Outputs::paths)),
         )?;
         let params = self.settings.params()?;
         let mut character = self.input.load_for_skinning()?;
@@ -214,18 +246,49 @@ impl SkinJob {
             source,
         })?;
         let mut timings = stage_timings(&skinned);
+        let findings = Findings::new(&character.warnings, &skinned);
+        let verdict = Verdict::new(&findings, &fail_on);
+        let rejected = verdict.rejected();
+        // A rejected character's outputs go under their rejected names, all of them when
+        // kept, else its report only.
+        let outputs = match &rejected_outputs {
+            Some(renamed) if rejected => renamed.clone(),
+            _ => self.outputs.clone(),
+        };
+        let write_all = !rejected || self.keep_rejected;
+        if let Some(renamed) = &rejected_outputs {
+            let written: Vec<&Path> = if write_all {
+                outputs.paths().collect()
+            } else {
+                outputs.report.iter().map(PathBuf::as_path).collect()
+            };
+            for path in self.outputs.paths().chain(renamed.paths()) {
+                if !written.contains(&path) {
+                    plan.remove(path)?;
+                }
+            }
+        }
 
         progress("writing");
-        let start = Instant::now();
-        let options = WriteOptions {
-            max_influences: params.max_influences,
-            ..WriteOptions::default()
+        let glb = if write_all {
+            let start = Instant::now();
+            let options = WriteOptions {
+                max_influences: params.max_influences,
+                ..WriteOptions::default()
+            };
+            // Nothing below reads the input's JSON document: it goes into the output uncopied.
+            let glb = skinned_glb_taking_document(
+                &mut character,
+                &skinned.weights,
+                &options,
+                &outputs.glb,
+            )?;
+            plan.write(&outputs.glb, &glb)?;
+            timings.insert("write".into(), json!(start.elapsed().as_secs_f64() * 1e3));
+            Some(glb)
+        } else {
+            None
         };
-        // Nothing below reads the input's JSON document: it goes into the output uncopied.
-        let glb =
-            skinned_glb_taking_document(&mut character, &skinned.weights, &options, &outputs.glb)?;
-        plan.write(&outputs.glb, &glb)?;
-        timings.insert("write".into(), json!(start.elapsed().as_secs_f64() * 1e3));
 
         let input_name = character.path.display().to_string();
         let written = outputs.report.is_some();
@@ -233,7 +296,8 @@ impl SkinJob {
         let report = (written || kept).then(|| {
             SkinReport::new(
                 &input_name,
-                &character.warnings,
+                &findings,
+                &verdict,
                 &skinned,
                 &timings,
                 character.gltf.as_ref(),
@@ -245,24 +309,29 @@ impl SkinJob {
             plan.write(path, &text)?;
         }
         let report = report.filter(|_| kept).map(|report| report.to_value());
-        if let Some(path) = &outputs.rig_info {
+        if let Some(path) = outputs.rig_info.as_ref().filter(|_| write_all) {
             let pruned = skinned.weights.pruned(params.max_influences);
             let text = atlas_skin_io::rig_info::to_text(&skeleton, &pruned, &character.file_vertex);
             plan.write(path, text.as_bytes())?;
         }
-        if let Some(path) = &outputs.debug_glb {
+        if let Some(path) = outputs.debug_glb.as_ref().filter(|_| write_all) {
             let bytes = debug_view(&skinned, path).map_err(|source| JobError::DebugView {
                 path: path.clone(),
                 source,
             })?;
             plan.write(path, &bytes)?;
         }
-        if let Some(path) = &outputs.html {
-            write_html(&glb, report.as_ref(), path, &plan)?;
+        if let (Some(path), Some(glb)) = (&outputs.html, &glb) {
+            write_html(glb, report.as_ref(), path, &plan)?;
         }
         let d = skinned.decomposition.report();
+        let destination = match (&glb, rejected) {
+            (Some(_), false) => outputs.glb.display().to_string(),
+            (Some(_), true) => format!("rejected, kept as {}", outputs.glb.display()),
+            (None, _) => "rejected, not written".to_string(),
+        };
         let summary = format!(
-            "{}: {} vertices, {} joints ({} cut, {} soft, {} skipped), {} regions -> {}",
+            "{}: {} vertices, {} joints ({} cut, {} soft, {} skipped), {} regions -> {destination}",
             input_name,
             skinned.counts.stored_vertices,
             skinned.counts.joints,
@@ -270,12 +339,13 @@ impl SkinJob {
             d.soft,
             d.skipped,
             skinned.decomposition.regions.len(),
-            outputs.glb.display()
         );
         Ok(JobOutcome {
             report,
             method_warnings: skinned.warnings,
             summary,
+            kept: glb.filter(|_| rejected).map(|_| outputs.glb.clone()),
+            verdict,
         })
     }
 }

@@ -1,7 +1,9 @@
 //! The JSON report of a skinned character (`atlas-skin skin --report`): the decomposition
 //! with each joint's overlap width and cut curve, the region of every vertex, timings,
-//! counts, how the pieces were weighted, and every warning.
+//! counts, how the pieces were weighted, every warning with its topic, and what the
+//! quality gate found and decided.
 
+use crate::quality::{Findings, Verdict};
 use atlas_skin::pipeline::Skinned;
 use atlas_skin::report::SharedSideReport;
 use atlas_skin::weights::pieces::PieceTreatment;
@@ -24,18 +26,21 @@ pub fn stage_timings(skinned: &Skinned) -> Map<String, Value> {
 /// The JSON report: `binding` (`smooth` or `rigid`), `decomposition` (the decomposition's
 /// own report, each joint with its `overlap_width` and cut `curve`, and the region of every
 /// stored vertex), `timings_ms`, `counts`, `pieces` (how each piece and each stored vertex was weighted, see
-/// [`TREATMENTS`]), `warnings`.
+/// [`TREATMENTS`]), `warnings` and their `warning_topics`, `quality` (the gate's findings
+/// and verdict).
 ///
 /// - `input`: the character's name (its path, as displayed).
-/// - `input_warnings`: what the reader noticed, listed before the method's warnings.
+/// - `findings`: what the reader and the method noticed ([`Findings::new`]).
+/// - `verdict`: the quality gate's ([`Verdict::new`]; the default: no gate).
 /// - `timings`: stage → milliseconds ([`stage_timings`], and any step of the caller).
 pub fn skin_report(
     input: &str,
-    input_warnings: &[String],
+    findings: &Findings,
+    verdict: &Verdict,
     skinned: &Skinned,
     timings: Map<String, Value>,
 ) -> Value {
-    SkinReport::new(input, input_warnings, skinned, &timings, None).to_value()
+    SkinReport::new(input, findings, verdict, skinned, &timings, None).to_value()
 }
 
 /// The JSON report of [`skin_report`] (with `vertex_ranges` when `gltf` is given), ready
@@ -49,10 +54,24 @@ pub struct SkinReport<'a> {
     decomposition: ReportDecomposition,
     input: &'a str,
     pieces: ReportPieces,
+    quality: ReportQuality<'a>,
     timings_ms: &'a Map<String, Value>,
     #[serde(skip_serializing_if = "Option::is_none")]
     vertex_ranges: Option<Vec<VertexRange>>,
-    warnings: Vec<String>,
+    warning_topics: Vec<&'static str>,
+    warnings: Vec<&'a str>,
+}
+
+/// What the quality gate found and decided ([`Findings`], [`Verdict`]), fields in sorted
+/// order: `fail_on` (the conditions asked for), `reasons` (why the character is rejected),
+/// `rejected`, and the joints two of the conditions name.
+#[derive(Serialize)]
+struct ReportQuality<'a> {
+    fail_on: &'a [crate::quality::Condition],
+    reasons: &'a [String],
+    rejected: bool,
+    soft_joints_without_weight: &'a [String],
+    unweighted_joints: &'a [String],
 }
 
 #[derive(Serialize)]
@@ -155,7 +174,8 @@ impl<'a> SkinReport<'a> {
     /// for `vertex_ranges` ([`vertex_ranges`]).
     pub fn new(
         input: &'a str,
-        input_warnings: &[String],
+        findings: &'a Findings,
+        verdict: &'a Verdict,
         skinned: &'a Skinned,
         timings: &'a Map<String, Value>,
         gltf: Option<&GltfSource>,
@@ -163,7 +183,6 @@ impl<'a> SkinReport<'a> {
         let decomposition = &skinned.decomposition;
         let counts = &skinned.counts;
         let weight_counts = &counts.weights;
-        let warnings = report_warnings(input_warnings, skinned);
         Self {
             binding: skinned.binding.name(),
             counts: ReportCounts {
@@ -184,6 +203,13 @@ impl<'a> SkinReport<'a> {
             decomposition: ReportDecomposition::new(skinned),
             input,
             pieces: ReportPieces::new(skinned),
+            quality: ReportQuality {
+                fail_on: &verdict.fail_on,
+                reasons: &verdict.reasons,
+                rejected: verdict.rejected(),
+                soft_joints_without_weight: &findings.soft_joints_without_weight,
+                unweighted_joints: &findings.unweighted_joints,
+            },
             timings_ms: timings,
             vertex_ranges: gltf.map(|source| {
                 source
@@ -198,7 +224,8 @@ impl<'a> SkinReport<'a> {
                     })
                     .collect()
             }),
-            warnings,
+            warning_topics: findings.warnings.iter().map(|&(topic, _)| topic).collect(),
+            warnings: findings.warnings.iter().map(|(_, w)| w.as_str()).collect(),
         }
     }
 
@@ -212,43 +239,6 @@ impl<'a> SkinReport<'a> {
     pub fn to_text(&self) -> Result<Vec<u8>, serde_json::Error> {
         serde_json::to_vec_pretty(self)
     }
-}
-
-/// The report's warnings: the reader's (`input_warnings`), the method's, then the soft
-/// joints whose boundary found no cross-section and that carry no weight in the end (a
-/// joint bound to a region, or given weight by a later step, is not named), and the stored
-/// vertices no triangle uses.
-fn report_warnings(input_warnings: &[String], skinned: &Skinned) -> Vec<String> {
-    let counts = &skinned.counts;
-    let weight_counts = &counts.weights;
-    let mut warnings = input_warnings.to_vec();
-    warnings.extend(skinned.warnings.iter().cloned());
-    let mut carries = vec![false; skinned.decomposition.joints.len()];
-    for (&j, &w) in skinned.weights.joints.iter().zip(&skinned.weights.weights) {
-        if w > 0.0 {
-            carries[j as usize] = true;
-        }
-    }
-    let names: Vec<&str> = weight_counts
-        .inactive_soft_joints
-        .iter()
-        .filter(|&&j| !carries[j as usize])
-        .map(|&j| skinned.decomposition.joints[j as usize].name.as_str())
-        .collect();
-    if !names.is_empty() {
-        warnings.push(format!(
-            "{} soft boundaries have no cross-section near their joint and carry no weight: {}",
-            names.len(),
-            names.join(", ")
-        ));
-    }
-    if counts.unreferenced_stored_vertices > 0 {
-        warnings.push(format!(
-            "{} stored vertices are used by no triangle: bound to their nearest bone",
-            counts.unreferenced_stored_vertices
-        ));
-    }
-    warnings
 }
 
 impl ReportDecomposition {
@@ -437,6 +427,7 @@ fn vertex_treatments(skinned: &Skinned) -> Vec<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::quality::Condition;
     use atlas_skin::fixtures::demo::demo_character;
     use atlas_skin::fixtures::pieces::demo_in_pieces;
     use atlas_skin::fixtures::shapes::icosphere;
@@ -463,7 +454,14 @@ mod tests {
             end_joints: &[],
         };
         let skinned = skin(input, &SkinParams::default(), &mut |_| {}).expect("skinned");
-        let report = skin_report("pieces", &[], &skinned, Map::new());
+        let findings = Findings::new(&[], &skinned);
+        let report = skin_report(
+            "pieces",
+            &findings,
+            &Verdict::default(),
+            &skinned,
+            Map::new(),
+        );
         let pieces = &report["pieces"];
         assert_eq!(pieces["treatments"], json!(TREATMENTS));
         let names: Vec<&str> = pieces["vertex_treatments"]
@@ -494,7 +492,8 @@ mod tests {
     /// objects keyed in sorted order by [`serde_json::Map`].
     fn skin_report_reference(
         input: &str,
-        input_warnings: &[String],
+        findings: &Findings,
+        verdict: &Verdict,
         skinned: &Skinned,
         timings: Map<String, Value>,
     ) -> Value {
@@ -531,7 +530,11 @@ mod tests {
 
         let counts = &skinned.counts;
         let weight_counts = &counts.weights;
-        let warnings = report_warnings(input_warnings, skinned);
+        let (warning_topics, warnings): (Vec<&str>, Vec<&str>) = findings
+            .warnings
+            .iter()
+            .map(|(topic, message)| (*topic, message.as_str()))
+            .unzip();
         json!({
             "input": input,
             "binding": skinned.binding.name(),
@@ -553,6 +556,14 @@ mod tests {
                 "inside_out_pieces": counts.inside_out_pieces,
             },
             "pieces": pieces_report_reference(skinned),
+            "quality": {
+                "fail_on": verdict.fail_on,
+                "reasons": verdict.reasons,
+                "rejected": verdict.rejected(),
+                "soft_joints_without_weight": findings.soft_joints_without_weight,
+                "unweighted_joints": findings.unweighted_joints,
+            },
+            "warning_topics": warning_topics,
             "warnings": warnings,
         })
     }
@@ -647,11 +658,15 @@ mod tests {
             let mut timings = stage_timings(&skinned);
             timings.insert("write".into(), json!(1.25));
             let warnings = vec!["a reader's warning".to_string()];
-            let mut reference = skin_report_reference(name, &warnings, &skinned, timings.clone());
+            let findings = Findings::new(&warnings, &skinned);
+            let verdict = Verdict::new(&findings, &[Condition::Input, Condition::Fallback]);
+            let mut reference =
+                skin_report_reference(name, &findings, &verdict, &skinned, timings.clone());
             if let Some(source) = &gltf {
                 reference["vertex_ranges"] = vertex_ranges(source);
             }
-            let report = SkinReport::new(name, &warnings, &skinned, &timings, gltf.as_ref());
+            let report =
+                SkinReport::new(name, &findings, &verdict, &skinned, &timings, gltf.as_ref());
             assert_eq!(report.to_value(), reference, "{name}");
             let text = report.to_text().expect("text");
             let expected = serde_json::to_string_pretty(&reference).expect("reference text");

@@ -1,13 +1,14 @@
 //! The Python package `atlas_skin` (its native module `atlas_skin._atlas_skin`): the
 //! method on numpy arrays (`compute_weights`), characters read into numpy (`load`, `demo`),
 //! posing (`deform_lbs`, `deform_dqs`), the file job of `atlas-skin skin` (`skin_file`)
-//! and of `atlas-skin batch` (`batch`). The GIL is released while Rust works; the signatures and their
+//! and of `atlas-skin batch` (`batch`); `fail_on` (the quality gate) raises
+//! `QualityGateError`. The GIL is released while Rust works; the signatures and their
 //! documentation are in `python/atlas_skin/_atlas_skin.pyi`.
 
 mod arrays;
 mod errors;
 
-use crate::errors::{no_panic, to_py_err};
+use crate::errors::{no_panic, rejected, to_py_err, QualityGateError};
 use atlas_skin::pipeline::{skin, SkinInput};
 use atlas_skin::weights::blend::Blend;
 use atlas_skin::weights::rigid::Binding;
@@ -16,6 +17,7 @@ use atlas_skin_io::{Character, LoadOptions};
 use atlas_skin_job::batch::{
     collect_inputs, plan_jobs, run_batch, BatchError, BatchOptions, Record,
 };
+use atlas_skin_job::quality::{Condition, Findings, Verdict};
 use atlas_skin_job::report::{skin_report, stage_timings};
 use atlas_skin_job::{error_chain, Input, JobError, Outputs, Settings, SkinJob};
 use atlas_skin_runtime::{reference, Skeleton, NO_PARENT};
@@ -25,7 +27,7 @@ use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use std::collections::{BTreeMap, HashSet};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, RecvTimeoutError};
 use std::sync::Mutex;
@@ -63,6 +65,7 @@ fn method_settings(options: Option<&Bound<'_, PyDict>>) -> PyResult<Settings> {
                 settings.binding = Some(one_of("binding", &name, &choices)?);
             }
             "force" => settings.force = value.extract().map_err(wrong_type)?,
+            "fail_on" => settings.fail_on = conditions(&value, wrong_type)?,
             "forbid" => settings.forbid = value.extract().map_err(wrong_type)?,
             "max_influences" => {
                 let n: i64 = value.extract().map_err(wrong_type)?;
@@ -92,6 +95,22 @@ fn one_of<T: Copy>(key: &str, name: &str, choices: &[(&str, T); 2]) -> PyResult<
             choices[0].0, choices[1].0
         ))),
     }
+}
+
+/// The quality gate's conditions of `fail_on`: a list of names, or one string of names
+/// separated by commas; `wrong_type` makes the error of anything else.
+fn conditions(
+    value: &Bound<'_, PyAny>,
+    wrong_type: impl Fn(PyErr) -> PyErr,
+) -> PyResult<Vec<Condition>> {
+    let names: Vec<String> = match value.extract::<String>() {
+        Ok(text) => text.split(',').map(|n| n.trim().to_string()).collect(),
+        Err(_) => value.extract().map_err(wrong_type)?,
+    };
+    names
+        .iter()
+        .map(|name| name.parse().map_err(PyValueError::new_err))
+        .collect()
 }
 
 /// A Python object from JSON (through the `json` module: dicts, lists, str, int, float).
@@ -208,11 +227,11 @@ fn compute_weights<'py>(
         })
         .collect::<PyResult<Vec<u32>>>()?;
     let settings = method_settings(options)?;
-    let (weights, report, k) = py.detach(|| {
+    let (weights, report, k, verdict) = py.detach(|| {
         no_panic(|| {
-            let params = settings
-                .params()
-                .map_err(|e| to_py_err(&JobError::Settings(e)))?;
+            let settings_error = |e| to_py_err(&JobError::Settings(e));
+            let params = settings.params().map_err(settings_error)?;
+            let fail_on = settings.fail_on().map_err(settings_error)?;
             let skinned = skin(
                 SkinInput {
                     positions: &positions,
@@ -229,10 +248,17 @@ fn compute_weights<'py>(
                     source,
                 })
             })?;
-            let report = skin_report(ARRAYS_NAME, &[], &skinned, stage_timings(&skinned));
-            Ok((skinned.weights, report, params.max_influences))
+            let findings = Findings::new(&[], &skinned);
+            let verdict = Verdict::new(&findings, &fail_on);
+            let timings = stage_timings(&skinned);
+            let report = skin_report(ARRAYS_NAME, &findings, &verdict, &skinned, timings);
+            Ok((skinned.weights, report, params.max_influences, verdict))
         })
     })?;
+    if verdict.rejected() {
+        let report = json_object(py, &report)?;
+        return Err(rejected(py, ARRAYS_NAME, &verdict, report, None));
+    }
     let (indices, weights) = arrays::weights_arrays(py, &weights, k)?;
     PyTuple::new(
         py,
@@ -366,7 +392,7 @@ fn deform<'py>(
 #[pyfunction]
 #[pyo3(signature = (
     input, output, *, report=None, html=None, debug_glb=None, rig_info=None, skeleton=None,
-    group=None, weights=None, **options
+    group=None, weights=None, keep_rejected=false, **options
 ))]
 fn skin_file<'py>(
     py: Python<'py>,
@@ -379,6 +405,7 @@ fn skin_file<'py>(
     skeleton: Option<PathBuf>,
     group: Option<String>,
     weights: Option<PathBuf>,
+    keep_rejected: bool,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let job = SkinJob {
@@ -399,16 +426,29 @@ fn skin_file<'py>(
             rig_info,
         },
         keep_report: true,
+        keep_rejected,
     };
     let outcome = py.detach(|| no_panic(|| job.run(&mut |_| {}).map_err(|e| to_py_err(&e))))?;
-    json_object(py, &outcome.report.unwrap_or_default())
+    let report = json_object(py, &outcome.report.unwrap_or_default())?;
+    if outcome.verdict.rejected() {
+        let what = job.input.path.as_deref().unwrap_or(Path::new("")).display();
+        let kept = outcome.kept.as_deref();
+        return Err(rejected(
+            py,
+            &what.to_string(),
+            &outcome.verdict,
+            report,
+            kept,
+        ));
+    }
+    Ok(report)
 }
 
 #[allow(clippy::too_many_arguments)]
 #[pyfunction]
 #[pyo3(signature = (
     inputs, out_dir, *, jobs=None, resume=false, report=false, html=false, log=None,
-    progress=None, **options
+    progress=None, keep_rejected=false, **options
 ))]
 fn batch<'py>(
     py: Python<'py>,
@@ -420,6 +460,7 @@ fn batch<'py>(
     html: bool,
     log: Option<PathBuf>,
     progress: Option<Bound<'py, PyAny>>,
+    keep_rejected: bool,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let inputs: Vec<PathBuf> = match inputs.extract::<PathBuf>() {
@@ -433,6 +474,7 @@ fn batch<'py>(
         report,
         html,
         log,
+        keep_rejected,
         settings: method_settings(options)?,
     };
     let refused = |e: BatchError| PyValueError::new_err(error_chain(&e));
@@ -444,9 +486,13 @@ fn batch<'py>(
     })?;
     // The batch runs on a thread of its own; this thread passes each finished record to
     // `progress` and checks for signals (Ctrl-C) meanwhile, stopping the batch on an
-    // exception from either.
+    // exception from either. The channel holds at most `jobs` records: a worker that
+    // finishes a file waits while this thread is that far behind, so a stop takes effect
+    // within a few files whatever `progress` does and however the threads are scheduled
+    // (with an unbounded channel, a slow `progress` or a starved calling thread let the
+    // workers finish the whole batch before a Ctrl-C was seen).
     let stop = AtomicBool::new(false);
-    let (sender, receiver) = mpsc::channel::<Record>();
+    let (sender, receiver) = mpsc::sync_channel::<Record>(options.jobs);
     // A receiver is not Sync; the lock only lets the wait run without the GIL.
     let receiver = Mutex::new(receiver);
     let mut interrupted: Option<PyErr> = None;
@@ -500,6 +546,7 @@ fn batch<'py>(
 #[pymodule]
 fn _atlas_skin(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("QualityGateError", m.py().get_type::<QualityGateError>())?;
     m.add_function(wrap_pyfunction!(compute_weights, m)?)?;
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(demo, m)?)?;

@@ -425,6 +425,7 @@ pub(crate) mod tests {
                     candidate_vertices: 100,
                     candidate_joints: 5,
                     joint_matches: Vec::new(),
+                    fit: None,
                     weights_l1: WeightsL1 {
                         mean: 0.5,
                         p95: 1.0,

@@ -257,6 +257,7 @@ mod tests {
             candidate_vertices: 10,
             candidate_joints: 2,
             joint_matches: Vec::new(),
+            fit: None,
             weights_l1: WeightsL1 {
                 mean: 0.1,
                 p95: 0.2,

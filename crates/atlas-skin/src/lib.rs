@@ -6,7 +6,7 @@
 //!
 //! | stage | paper | module |
 //! | --- | --- | --- |
-//! | what every stage shares: tolerances, boxes and segments, rows of a flat table, the developer switches that turn rules off | | [`tolerance`], [`geometry`], [`rows`], [`ablation`] |
+//! | what every stage shares: tolerances, boxes and segments, rows of a flat table, the developer switches that turn rules off, warnings by topic | | [`tolerance`], [`geometry`], [`rows`], [`ablation`], [`warning`] |
 //! | the surface: welding, topology, spatial index, winding number | | [`mesh`] |
 //! | bones as segments, nearest bones, helper joints, whether the skeleton sits in the mesh | | [`skeleton`] |
 //! | boundaries at the joints: joint roles, plane search, plane sections, conflicts, split | §3.1 | [`cuts`] |
@@ -33,6 +33,7 @@ pub mod report;
 pub mod rows;
 pub mod skeleton;
 pub mod tolerance;
+pub mod warning;
 pub mod weights;
 
 pub use decompose::{decompose, DecomposeError, DecomposeParams};
@@ -41,3 +42,4 @@ pub use decomposition::{
 };
 pub use mesh::{weld, MeshStats, SurfaceMesh, Topology, Welded};
 pub use pipeline::{skin, SkinError, SkinInput, SkinParams, Skinned};
+pub use warning::{Warning, WarningTopic};

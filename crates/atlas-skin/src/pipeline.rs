@@ -24,6 +24,7 @@ use crate::rows::{Rows, PAR_CHUNK};
 use crate::skeleton::bones::{bone_segments, capped_extensions, nearest_bone, EXTENSION_JOINTS};
 use crate::skeleton::hierarchy::infer_hierarchy;
 use crate::skeleton::placement::{check_placement, PlacementError};
+use crate::warning::{Warning, WarningTopic};
 use crate::weights::blend::Blend;
 use crate::weights::rigid::{bind_rigidly, Binding};
 use crate::weights::{compute_weights, SurfaceWeights, WeightCounts, WeightsError};
@@ -177,9 +178,10 @@ pub struct Skinned {
     /// The skeleton the method used: the input's, or with an inferred hierarchy when the
     /// input's had several roots (same joints, names and bind pose).
     pub skeleton: Skeleton,
-    /// What the method noticed and handled: an inferred hierarchy, duplicate faces, joints
-    /// beside or outside the mesh, duplicate joints, zero-length bones, no boundary.
-    pub warnings: Vec<String>,
+    /// What the method noticed and handled, each with its topic: an inferred hierarchy,
+    /// duplicate faces, joints beside or outside the mesh, duplicate joints, zero-length
+    /// bones, no boundary.
+    pub warnings: Vec<Warning>,
 }
 
 /// A welded surface with its topology: what every analysis of the mesh starts from.
@@ -222,9 +224,12 @@ pub fn skin(
     done(&mut timings);
     let mut warnings = Vec::new();
     if duplicate_faces > 0 {
-        warnings.push(format!(
-            "{duplicate_faces} duplicate faces (the same three vertices as an earlier face) \
-             were left out of the method"
+        warnings.push(Warning::new(
+            WarningTopic::Mesh,
+            format!(
+                "{duplicate_faces} duplicate faces (the same three vertices as an earlier \
+                 face) were left out of the method"
+            ),
         ));
     }
 
@@ -232,24 +237,35 @@ pub fn skin(
     let mut topology = Topology::new(&welded.mesh);
     let inside_out = turn_inside_out_pieces(&mut welded.mesh, &mut topology);
     if inside_out > 0 {
-        warnings.push(format!(
-            "{inside_out} closed piece(s) were wound inside out: turned outward for the method"
+        warnings.push(Warning::new(
+            WarningTopic::Mesh,
+            format!(
+                "{inside_out} closed piece(s) were wound inside out: turned outward for the \
+                 method"
+            ),
         ));
     }
     done(&mut timings);
 
     let done = run(Stage::Decompose);
-    warnings.extend(check_placement(input.skeleton, &welded.mesh.positions)?);
+    warnings.extend(
+        check_placement(input.skeleton, &welded.mesh.positions)?
+            .into_iter()
+            .map(|message| Warning::new(WarningTopic::Placement, message)),
+    );
     let skeleton = method_skeleton(input.skeleton, &welded.mesh.positions, &mut warnings);
     let capped = capped_extensions(&skeleton);
     if let Some(&first) = capped.first() {
-        warnings.push(format!(
-            "{} leaf joint(s) without a tail (the first: {}) continue their bone past \
-             {EXTENSION_JOINTS} or more other joints: each continuation stops at the \
-             {EXTENSION_JOINTS}th (a rig of many siblings on one line; on no benchmark \
-             character does this happen)",
-            capped.len(),
-            skeleton.names[first as usize]
+        warnings.push(Warning::new(
+            WarningTopic::Skeleton,
+            format!(
+                "{} leaf joint(s) without a tail (the first: {}) continue their bone past \
+                 {EXTENSION_JOINTS} or more other joints: each continuation stops at the \
+                 {EXTENSION_JOINTS}th (a rig of many siblings on one line; on no benchmark \
+                 character does this happen)",
+                capped.len(),
+                skeleton.names[first as usize]
+            ),
         ));
     }
     let decomposition = decompose(&welded.mesh, &topology, &skeleton, &params.decompose)?;
@@ -315,7 +331,7 @@ pub fn skin(
 fn method_skeleton(
     skeleton: &Skeleton,
     vertices: &[DVec3],
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<Warning>,
 ) -> Skeleton {
     let centroid = vertices.iter().sum::<DVec3>() / vertices.len().max(1) as f64;
     let Some(inferred) = infer_hierarchy(skeleton, centroid) else {
@@ -325,7 +341,10 @@ fn method_skeleton(
         .parents
         .iter()
         .any(|&p| p != atlas_skin_runtime::NO_PARENT);
-    warnings.push(inferred.warning(skeleton, had_links));
+    warnings.push(Warning::new(
+        WarningTopic::Skeleton,
+        inferred.warning(skeleton, had_links),
+    ));
     Skeleton {
         parents: inferred.parents,
         ..skeleton.clone()

@@ -6,6 +6,7 @@
 use atlas_skin::fixtures::demo::{demo_character, DemoCharacter, DEFAULT_STEP};
 use atlas_skin::pipeline::{skin, SkinError, SkinInput, SkinParams, Skinned};
 use atlas_skin::skeleton::placement::PlacementError;
+use atlas_skin::WarningTopic;
 use atlas_skin_runtime::{Skeleton, NO_PARENT};
 use glam::{Mat4, Vec3};
 use std::sync::OnceLock;
@@ -27,6 +28,17 @@ fn run(
         end_joints: &[],
     };
     skin(input, &SkinParams::default(), &mut |_| {})
+}
+
+/// The messages of the warnings of `topic`, one per line.
+fn warnings_on(skinned: &Skinned, topic: WarningTopic) -> String {
+    skinned
+        .warnings
+        .iter()
+        .filter(|w| w.topic == topic)
+        .map(|w| w.message.as_str())
+        .collect::<Vec<_>>()
+        .join("\n")
 }
 
 /// The joints' decisions (name, status) and every boundary (joint, kind, plane, curve), as JSON.
@@ -89,8 +101,11 @@ fn a_webxr_hand_without_links_gets_the_boundaries_of_the_linked_hand() {
 
     let from_links = run(&demo.positions, &triangles, &linked).unwrap();
     let from_names = run(&demo.positions, &triangles, &webxr).unwrap();
-    assert!(from_links.warnings.iter().all(|w| !w.contains("inferred")));
-    let warning = from_names.warnings.join("\n");
+    assert!(from_links
+        .warnings
+        .iter()
+        .all(|w| !w.message.contains("inferred")));
+    let warning = warnings_on(&from_names, WarningTopic::Skeleton);
     assert!(
         warning.contains("have no parent links") && warning.contains("WebXR hand"),
         "{warning}"
@@ -123,7 +138,7 @@ fn upper_legs_stored_as_roots_are_attached_to_the_hips() {
     }
     let linked = run(&demo.positions, &demo.triangles, &demo.skeleton).unwrap();
     let inferred = run(&demo.positions, &demo.triangles, &loose).unwrap();
-    let warning = inferred.warnings.join("\n");
+    let warning = warnings_on(&inferred, WarningTopic::Skeleton);
     assert!(
         warning.contains("3 roots")
             && warning.contains("upleg_l → hips")
@@ -148,7 +163,7 @@ fn unlinked_joints_get_a_tree_from_positions() {
     )
     .unwrap();
     let skinned = run(&demo.positions, &demo.triangles, &loose).unwrap();
-    let warning = skinned.warnings.join("\n");
+    let warning = warnings_on(&skinned, WarningTopic::Skeleton);
     assert!(warning.contains("link(s) from positions"), "{warning}");
     let cuts = skinned.decomposition.report().cuts;
     assert!(cuts >= 30, "{cuts} cuts (33 with the demo's links)");
@@ -175,10 +190,7 @@ fn duplicate_faces_give_the_cuts_of_the_clean_mesh() {
     ] {
         let skinned = run(&demo.positions, &triangles, &demo.skeleton).unwrap();
         assert_eq!(skinned.counts.duplicate_faces, removed);
-        assert!(skinned
-            .warnings
-            .iter()
-            .any(|w| w.contains("duplicate faces")));
+        assert!(warnings_on(&skinned, WarningTopic::Mesh).contains("duplicate faces"));
         assert_eq!(boundaries(&skinned), boundaries(&clean));
         assert_eq!(skinned.weights, clean.weights);
     }
@@ -227,7 +239,8 @@ fn a_skeleton_that_does_not_sit_in_the_body_is_refused_or_warned_about() {
         inverse_bind: vec![Mat4::from_translation(-Vec3::Y); demo.skeleton.len()],
         ..demo.skeleton.clone()
     };
-    let warnings = skin_with(&one_point).unwrap().warnings.join("\n");
+    let skinned = skin_with(&one_point).unwrap();
+    let warnings = warnings_on(&skinned, WarningTopic::Placement);
     assert!(
         warnings.contains("all 35 joints sit at one point"),
         "{warnings}"
@@ -237,7 +250,7 @@ fn a_skeleton_that_does_not_sit_in_the_body_is_refused_or_warned_about() {
         &demo.skeleton,
         Mat4::from_translation(Vec3::new(1.0, 0.0, 0.0)),
     );
-    let warnings = skin_with(&aside).unwrap().warnings.join("\n");
+    let warnings = warnings_on(&skin_with(&aside).unwrap(), WarningTopic::Placement);
     assert!(
         warnings.contains("joints lie beside the mesh"),
         "{warnings}"
@@ -248,7 +261,7 @@ fn a_skeleton_that_does_not_sit_in_the_body_is_refused_or_warned_about() {
         * Mat4::from_rotation_z(std::f32::consts::PI)
         * Mat4::from_translation(-centre);
     let upside_down = skin_with(&moved(&demo.skeleton, flip)).unwrap();
-    let warnings = upside_down.warnings.join("\n");
+    let warnings = warnings_on(&upside_down, WarningTopic::Placement);
     assert!(warnings.contains("may not sit in the body"), "{warnings}");
 }
 
@@ -298,7 +311,7 @@ fn joints_named_as_helpers_move_no_skin() {
         skin(input, &params, &mut |_| {}).unwrap()
     };
     let skinned = skin_with(Vec::new());
-    let warning = skinned.warnings.join("\n");
+    let warning = warnings_on(&skinned, WarningTopic::Skeleton);
     assert!(
         warning.contains("6 joint(s) named as helpers")
             && helpers.iter().all(|(name, ..)| warning.contains(name)),
@@ -327,5 +340,8 @@ fn joints_named_as_helpers_move_no_skin() {
     let forced = skin_with(vec!["handslot.l".into()]);
     assert!(forced.decomposition.joints[s.len()].owns_skin);
     assert!(weighted(&forced, s.len()));
-    assert!(!forced.warnings.join("\n").contains("handslot.l"));
+    assert!(forced
+        .warnings
+        .iter()
+        .all(|w| !w.message.contains("handslot.l")));
 }

@@ -1,8 +1,10 @@
 //! `atlas-skin batch`: many characters at once (the batch itself:
 //! [`atlas_skin_job::batch`]), with one progress bar, the failures printed as they come and
-//! the totals at the end; the exit code is non-zero when any file failed.
+//! the totals at the end; the exit code is 1 when any file failed, else 3 when the quality
+//! gate rejected any.
 
 use crate::cmd::skin::MethodArgs;
+use crate::quality_gate::{GateArgs, Rejected};
 use anyhow::{bail, Result};
 use atlas_skin_job::batch::{collect_inputs, plan_jobs, run_batch, BatchOptions, Record, Status};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -38,6 +40,8 @@ pub struct Args {
     pub log: Option<PathBuf>,
     #[command(flatten)]
     pub method: MethodArgs,
+    #[command(flatten)]
+    pub gate: GateArgs,
 }
 
 pub fn run(args: Args) -> Result<()> {
@@ -49,7 +53,8 @@ pub fn run(args: Args) -> Result<()> {
         report: args.report,
         html: args.html,
         log: args.log,
-        settings: args.method.settings()?,
+        keep_rejected: args.gate.keep_rejected,
+        settings: args.method.settings(&args.gate)?,
         out_dir: args.out_dir,
     };
     let inputs = collect_inputs(&args.inputs)?;
@@ -59,6 +64,10 @@ pub fn run(args: Args) -> Result<()> {
         if record.status == Status::Failed {
             let message = record.error.as_deref().unwrap_or_default();
             bar.suspend(|| eprintln!("error: {message}"));
+        }
+        if record.status == Status::Rejected {
+            let reasons = record.reasons.join("; ");
+            bar.suspend(|| eprintln!("rejected: {}: {reasons}", record.input));
         }
         bar.inc(1);
     };
@@ -72,6 +81,15 @@ pub fn run(args: Args) -> Result<()> {
             summary.files,
             summary.log.display()
         );
+    }
+    if summary.rejected > 0 {
+        return Err(Rejected(format!(
+            "the quality gate rejected {} of {} files (see {})",
+            summary.rejected,
+            summary.files,
+            summary.log.display()
+        ))
+        .into());
     }
     Ok(())
 }

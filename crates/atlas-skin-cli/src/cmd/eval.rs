@@ -5,7 +5,9 @@
 use crate::input::{InputArgs, Prepared, ReadArgs};
 use anyhow::{Context, Result};
 use atlas_skin_eval::matching::{JointMatch, JointPair};
-use atlas_skin_eval::{evaluate, Animation, EvalInput, EvalOptions, Evaluation, Weighted};
+use atlas_skin_eval::{
+    evaluate, Animation, EvalInput, EvalOptions, Evaluation, FitSource, Weighted,
+};
 use atlas_skin_io::{Character, LoadOptions};
 use std::path::PathBuf;
 
@@ -18,7 +20,8 @@ pub struct Args {
     /// The candidate: a skinned file (.glb/.gltf/.vrm, .fbx) of the same character, e.g.
     /// another tool's export. Joints are matched by name, then by name ignoring case and
     /// punctuation, then by bind position; vertices by position (seams may be split
-    /// differently).
+    /// differently), after fitting a uniform scale, a Y-up/Z-up turn and a translation when
+    /// fewer than half pair as stored (other units or axes: the output says what was fitted).
     pub candidate: PathBuf,
     /// How to read the reference (--skeleton, --group, --weights).
     #[command(flatten)]
@@ -197,6 +200,23 @@ fn summary(e: &Evaluation) -> String {
             "vertices {} (matched {}), joints {}; candidate: {} vertices, {} joints\n",
             e.vertices, e.matched, e.joints, e.candidate_vertices, e.candidate_joints
         ),
+        e.fit.map_or_else(String::new, |fit| {
+            let t = fit.translation;
+            format!(
+                "{:<22} candidate fitted onto the reference (from the {}): scale {:.6}, {}, \
+                 then moved by ({:.4}, {:.4}, {:.4})\n",
+                "units and axes",
+                match fit.from {
+                    FitSource::BoundingBoxes => "meshes' bounding boxes",
+                    FitSource::Skeletons => "skeletons' bounding boxes",
+                },
+                fit.scale,
+                fit.turn.describe(),
+                t[0],
+                t[1],
+                t[2]
+            )
+        }),
         joint_matches(&e.joint_matches),
         format!(
             "{:<22} mean {:.3}  p95 {:.3}  max {:.3}  dominant joint agrees {:.1}%\n",

@@ -4,6 +4,7 @@
 //! (the job itself: [`atlas_skin_job::SkinJob`], shared with `batch` and the Python package).
 
 use crate::input::InputArgs;
+use crate::quality_gate::{GateArgs, Rejected};
 use anyhow::{bail, Context, Result};
 use atlas_skin::weights::blend::Blend;
 use atlas_skin::weights::rigid::Binding;
@@ -26,6 +27,8 @@ pub struct Args {
     pub report: Option<PathBuf>,
     #[command(flatten)]
     pub method: MethodArgs,
+    #[command(flatten)]
+    pub gate: GateArgs,
     /// Write an unskinned glb with the regions as vertex colours and the cut curves.
     #[arg(long, value_name = "D.glb")]
     pub debug_glb: Option<PathBuf>,
@@ -43,7 +46,8 @@ pub struct Args {
 #[derive(clap::Args)]
 pub struct MethodArgs {
     /// Settings as JSON (any subset of `decompose`, `overlap` {`factor`, `per_joint`},
-    /// `blend`, `binding`, `max_influences`); the options below override it.
+    /// `blend`, `binding`, `max_influences`, and the quality gate's `fail_on`); the options
+    /// below override it.
     #[arg(long, value_name = "FILE.json")]
     pub config: Option<PathBuf>,
     /// Overlap half-width as a multiple of each boundary's diameter (the paper: 0.5).
@@ -111,8 +115,8 @@ impl From<BindingArg> for Binding {
 }
 
 impl MethodArgs {
-    /// The job's settings; `--overlap-joint` entries parsed.
-    pub fn settings(&self) -> Result<Settings> {
+    /// The job's settings, with the gate's conditions; `--overlap-joint` entries parsed.
+    pub fn settings(&self, gate: &GateArgs) -> Result<Settings> {
         let mut overlap_joints = Vec::new();
         for entry in &self.overlap_joint {
             let Some((name, value)) = entry.rsplit_once('=') else {
@@ -132,6 +136,7 @@ impl MethodArgs {
             force: self.force.clone(),
             forbid: self.forbid.clone(),
             max_influences: self.max_influences,
+            fail_on: gate.fail_on.clone(),
         })
     }
 }
@@ -139,7 +144,7 @@ impl MethodArgs {
 pub fn run(args: Args) -> Result<()> {
     let job = SkinJob {
         input: args.input.job_input(),
-        settings: args.method.settings()?,
+        settings: args.method.settings(&args.gate)?,
         outputs: Outputs {
             glb: args.output,
             report: args.report,
@@ -148,6 +153,7 @@ pub fn run(args: Args) -> Result<()> {
             rig_info: args.rig_info,
         },
         keep_report: false,
+        keep_rejected: args.gate.keep_rejected,
     };
     let progress = progress_bar();
     let outcome = job.run(&mut |step| progress.set_message(step));
@@ -157,6 +163,13 @@ pub fn run(args: Args) -> Result<()> {
         eprintln!("warning: {warning}");
     }
     println!("{}", outcome.summary);
+    if outcome.verdict.rejected() {
+        return Err(Rejected(format!(
+            "the quality gate rejected the character: {}",
+            outcome.verdict.reasons.join("; ")
+        ))
+        .into());
+    }
     Ok(())
 }
 

@@ -28,6 +28,12 @@ pub fn atlas_skin_ok<A: AsRef<OsStr>>(args: &[A]) -> Output {
     output
 }
 
+/// `atlas-skin eval REFERENCE CANDIDATE --json`, parsed; fails unless it exits 0.
+pub fn eval_json(reference: &Path, candidate: &Path) -> serde_json::Value {
+    let output = atlas_skin_ok(&[Path::new("eval"), reference, candidate, Path::new("--json")]);
+    serde_json::from_slice(&output.stdout).expect("eval's JSON")
+}
+
 /// Runs `atlas-skin skin INPUT -o DIR/STEM.glb --report DIR/STEM.json` and returns the
 /// written glb's path and the report.
 pub fn skin_with_report(input: &Path, dir: &Path, stem: &str) -> (PathBuf, serde_json::Value) {

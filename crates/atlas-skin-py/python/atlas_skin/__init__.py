@@ -12,7 +12,9 @@ Thibert, INRIA RR-6406, 2008, with the extensions of the atlas-skin project).
 - ``batch``: the job of ``atlas-skin batch`` (many files, several at a time, a log).
 
 Bad input raises ``ValueError`` (``FileNotFoundError`` for a missing file) with the
-message the command line prints. The GIL is released while the Rust code works.
+message the command line prints. With ``fail_on`` (the quality gate), a rejected character
+raises ``QualityGateError`` (``batch`` records it as ``"rejected"``). The GIL is released
+while the Rust code works.
 """
 
 from typing import Any
@@ -20,7 +22,16 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ._atlas_skin import __version__, batch, compute_weights, deform, demo, load, skin_file
+from ._atlas_skin import (
+    QualityGateError,
+    __version__,
+    batch,
+    compute_weights,
+    deform,
+    demo,
+    load,
+    skin_file,
+)
 
 
 def deform_lbs(positions: Any, indices: Any, weights: Any, palette: Any) -> npt.NDArray[np.float32]:
@@ -44,6 +55,7 @@ def deform_dqs(positions: Any, indices: Any, weights: Any, palette: Any) -> npt.
 
 
 __all__ = [
+    "QualityGateError",
     "__version__",
     "batch",
     "compute_weights",

@@ -1,7 +1,7 @@
 """Type stubs of atlas_skin's native module (crates/atlas-skin-py/src/lib.rs)."""
 
 from os import PathLike
-from typing import Any, Callable, Dict, Mapping, Optional, Sequence, Tuple, TypedDict, Union
+from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, TypedDict, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -10,6 +10,23 @@ from typing_extensions import Unpack
 __version__: str
 
 StrPath = Union[str, "PathLike[str]"]
+
+class QualityGateError(Exception):
+    """The quality gate (``fail_on``) rejected the character.
+
+    - ``reasons``: why, one ``"CONDITION: cause"`` per cause (e.g. ``"soft-joints: 2 soft
+      joint(s) carry no weight: LHandEX, RHandEX"``);
+    - ``report``: the JSON report (a dict); its ``quality`` holds ``fail_on``,
+      ``rejected``, ``reasons`` and the joints ``soft-joints`` and ``unweighted-joints``
+      name;
+    - ``output``: the skinned glb written under its rejected name
+      (``OUT.rejected.glb``) when ``keep_rejected`` asked for it, else None.
+    """
+
+    reasons: List[str]
+    report: Dict[str, Any]
+    output: Optional[str]
+
 FloatArray = npt.ArrayLike
 """float32 or float64 values (a numpy array or anything ``numpy.asarray`` takes)."""
 IntArray = npt.ArrayLike
@@ -38,8 +55,17 @@ class MethodOptions(TypedDict, total=False):
     - ``max_influences``: influences kept per vertex, the largest, renormalised (1..=32,
       default 4) (``--max-influences``).
     - ``config``: a settings file (``--config``: JSON, any subset of ``decompose``,
-      ``overlap`` {``factor``, ``per_joint``}, ``blend``, ``binding``, ``max_influences``),
-      which the options above override.
+      ``overlap`` {``factor``, ``per_joint``}, ``blend``, ``binding``,
+      ``max_influences``, ``fail_on``), which the options above override.
+    - ``fail_on``: the quality gate (``--fail-on``): conditions, as a list of names or one
+      string of names separated by commas, on which the character is rejected:
+      ``"warnings"`` (any warning), ``"input"``, ``"mesh"``, ``"placement"``,
+      ``"skeleton"``, ``"weights"`` (a warning of that topic: the report's
+      ``warning_topics``), ``"fallback"`` (a vertex weighted by a fallback),
+      ``"soft-joints"`` (a soft joint that carries no weight), ``"unweighted-joints"`` (a
+      joint given a boundary that carries no weight). ``compute_weights`` and
+      ``skin_file`` raise ``QualityGateError``; ``batch`` records the file as
+      ``"rejected"``. An unknown name raises ``ValueError``.
     """
 
     overlap: Optional[float]
@@ -50,6 +76,7 @@ class MethodOptions(TypedDict, total=False):
     forbid: Optional[Sequence[str]]
     max_influences: Optional[int]
     config: Optional[StrPath]
+    fail_on: Optional[Union[str, Sequence[str]]]
 
 def compute_weights(
     vertices: FloatArray,
@@ -89,14 +116,15 @@ def compute_weights(
       handles): given no boundary unless forced.
     - ``**options``: the method's options (``MethodOptions``: ``overlap``,
       ``overlap_joints``, ``blend``, ``binding``, ``force``, ``forbid``, ``max_influences``,
-      ``config``).
+      ``config``, ``fail_on``).
 
     Returns ``(indices, weights, report)``: ``(V, K)`` uint32 joint indices and ``(V, K)``
     float32 weights with ``K = max_influences``, each row summing to 1, unused slots joint
     0 with weight 0; and the JSON report of ``atlas-skin skin --report`` as a dict
-    (decomposition, counts, timings, warnings).
+    (decomposition, counts, timings, warnings and their topics, quality).
 
-    Raises ``ValueError`` for a wrong shape or dtype, a value that is not finite, an
+    Raises ``QualityGateError`` when ``fail_on`` rejects the result (its ``report`` is the
+    report), ``ValueError`` for a wrong shape or dtype, a value that is not finite, an
     index out of range, an invalid skeleton (a cycle), or input the method refuses (the
     message of the command line, e.g. ``cannot skin the given arrays: ...``);
     ``FileNotFoundError`` for a missing ``config``.
@@ -160,6 +188,7 @@ def skin_file(
     skeleton: Optional[StrPath] = None,
     group: Optional[str] = None,
     weights: Optional[StrPath] = None,
+    keep_rejected: bool = False,
     **options: Unpack[MethodOptions],
 ) -> Dict[str, Any]:
     """The job of ``atlas-skin skin INPUT -o OUTPUT``: reads the character, computes its
@@ -167,6 +196,12 @@ def skin_file(
     the ``html`` report, the ``debug_glb`` view and the ``rig_info`` text), each written to
     a temporary file and renamed, never over an input. ``skeleton``, ``group``,
     ``weights`` as ``load``; the method's options as ``compute_weights``.
+
+    With ``fail_on``, a rejected character raises ``QualityGateError``: its outputs are
+    not written but the ``report``, under its rejected name (``R.rejected.json``), or,
+    with ``keep_rejected`` (``--keep-rejected``), all of them under their rejected names
+    (``OUT.rejected.glb``, the exception's ``output``); an earlier run's outputs under
+    either name are removed.
 
     Returns the report (a dict, as ``report`` holds it). Raises ``FileNotFoundError`` for a
     missing input, ``ValueError`` with the command line's message for anything else.
@@ -182,6 +217,7 @@ def batch(
     html: bool = False,
     log: Optional[StrPath] = None,
     progress: Optional[Callable[[Dict[str, Any]], object]] = None,
+    keep_rejected: bool = False,
     **options: Unpack[MethodOptions],
 ) -> Dict[str, Any]:
     """The job of ``atlas-skin batch INPUT... -o OUT_DIR``: every character of ``inputs``
@@ -194,16 +230,25 @@ def batch(
     ``OUT_DIR/atlas-skin-batch.jsonl``). The method's options as ``compute_weights``.
 
     ``progress`` is called on the calling thread with each record as its file finishes
-    (for a progress bar). An exception from it, or Ctrl-C (``KeyboardInterrupt``), stops
-    the batch: the files running finish (their outputs complete), the others are not
-    started and are logged as ``"cancelled"``, then the exception is raised.
+    (for a progress bar); a worker that finishes a file waits while ``jobs`` records are
+    not yet taken. An exception from it, or Ctrl-C (``KeyboardInterrupt``), stops the
+    batch within a few files: the files running finish (their outputs complete), the
+    others are not started and are logged as ``"cancelled"``, then the exception is
+    raised. (A Python started with SIGINT ignored, as a background job of a
+    non-interactive shell is, does not turn Ctrl-C into ``KeyboardInterrupt``: call
+    ``signal.signal(signal.SIGINT, signal.default_int_handler)`` first.)
+
+    With ``fail_on``, a file the gate rejects is recorded as ``"rejected"`` with its
+    ``reasons``, its outputs written under their rejected names only with
+    ``keep_rejected`` (the record's ``kept``), as ``skin_file`` writes them.
 
     Returns ``{"records": [...], "summary": {...}}``: one record per file, in the order
-    of the inputs (``input``, ``output``, ``status``: ``"ok"``, ``"failed"`` or
-    ``"skipped"``, ``"cancelled"``, ``error``: the message ``skin`` would print or None, ``seconds``,
-    ``timings_ms``, ``counts``, ``warnings``), and the totals (``files``, ``ok``,
-    ``failed``, ``skipped``, ``cancelled``, ``seconds``, ``characters_per_second``, ``log``). A failed
-    file is in the records, not raised. Raises ``ValueError`` when the batch cannot start
+    of the inputs (``input``, ``output``, ``status``: ``"ok"``, ``"failed"``,
+    ``"skipped"``, ``"cancelled"`` or ``"rejected"``, ``error``: the message ``skin`` would
+    print or None, ``reasons``, ``kept``, ``seconds``, ``timings_ms``, ``counts``,
+    ``warnings``), and the totals (``files``, ``ok``, ``failed``, ``skipped``,
+    ``cancelled``, ``rejected``, ``seconds``, ``characters_per_second``, ``log``). A failed
+    or rejected file is in the records, not raised. Raises ``ValueError`` when the batch cannot start
     (a pattern matching nothing, a folder without character files, two inputs with one
     name, an output over an input).
     """
