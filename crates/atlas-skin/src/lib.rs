@@ -13,6 +13,7 @@
 //! | overlaps: surface distances from each cut, widths | §3.3 | [`overlap`] |
 //! | weights: blending, chains, soft boundaries, patches | §4, §5 | [`weights`] |
 //! | what the report shows of a decomposition | | [`report`] |
+//! | weights carried from a skinned surface onto other meshes (Abdrashitov et al. 2023) | | [`transfer`] |
 //! | shapes with known answers and the demo character | | [`fixtures`] |
 
 pub mod cuts;
@@ -28,6 +29,7 @@ pub mod report;
 pub mod rows;
 pub mod skeleton;
 pub mod tolerance;
+pub mod transfer;
 pub mod weights;
 
 pub use decompose::{decompose, DecomposeError, DecomposeParams};
