@@ -52,7 +52,12 @@ impl Operators {
             let longest = (0..3)
                 .map(|i| p[i].distance_squared(p[(i + 1) % 3]))
                 .fold(0.0, f64::max);
-            if !(double_area > FLAT * longest) || t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+            if double_area.is_nan()
+                || double_area <= FLAT * longest
+                || t[0] == t[1]
+                || t[1] == t[2]
+                || t[0] == t[2]
+            {
                 continue;
             }
             // Corner i's angle lies between the edges to the two other corners.
@@ -60,11 +65,11 @@ impl Operators {
                 let (j, k) = ((i + 1) % 3, (i + 2) % 3);
                 cot(p[j] - p[i], p[k] - p[i])
             });
-            for i in 0..3 {
+            for (i, &cot_i) in cots.iter().enumerate() {
                 let (j, k) = ((i + 1) % 3, (i + 2) % 3);
                 // The edge jk is opposite corner i.
-                entries.push((t[j], t[k], cots[i]));
-                entries.push((t[k], t[j], cots[i]));
+                entries.push((t[j], t[k], cot_i));
+                entries.push((t[k], t[j], cot_i));
             }
             let area = 0.5 * double_area;
             let obtuse = (0..3).find(|&i| cots[i] < 0.0);
@@ -81,7 +86,7 @@ impl Operators {
                 };
             }
         }
-        entries.sort_unstable_by(|a, b| (a.0, a.1).cmp(&(b.0, b.1)));
+        entries.sort_unstable_by_key(|&(i, j, _)| (i, j));
         let mut merged: Vec<(u32, u32, f64)> = Vec::with_capacity(entries.len());
         for (i, j, w) in entries {
             match merged.last_mut() {
