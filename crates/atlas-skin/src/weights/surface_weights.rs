@@ -102,6 +102,10 @@ pub struct PieceWeighting {
     #[serde(flatten)]
     pub treatment: PieceTreatment,
     pub vertices: usize,
+    /// A bone runs through it (body pieces, and the pieces of [`super::pieces`] that hold
+    /// bones); false for the pieces that hold none (clothes, hair, props).
+    #[serde(skip)]
+    pub holds_bones: bool,
 }
 
 /// A gap of a body piece (vertices no region with joints reaches, joined by edges) and how
