@@ -10,6 +10,8 @@ Thibert, INRIA RR-6406, 2008, with the extensions of the atlas-skin project).
   skinning.
 - ``skin_file``: the job of ``atlas-skin skin`` (a character file to a skinned glb).
 - ``batch``: the job of ``atlas-skin batch`` (many files, several at a time, a log).
+- ``transfer``: a skinned mesh's weights carried onto other meshes (clothes, hair, props),
+  on numpy arrays; ``transfer_file``: the job of ``atlas-skin transfer``.
 
 Bad input raises ``ValueError`` (``FileNotFoundError`` for a missing file) with the
 message the command line prints. The GIL is released while the Rust code works.
@@ -20,7 +22,17 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ._atlas_skin import __version__, batch, compute_weights, deform, demo, load, skin_file
+from ._atlas_skin import (
+    __version__,
+    batch,
+    compute_weights,
+    deform,
+    demo,
+    load,
+    skin_file,
+    transfer,
+    transfer_file,
+)
 
 
 def deform_lbs(positions: Any, indices: Any, weights: Any, palette: Any) -> npt.NDArray[np.float32]:
@@ -52,4 +64,6 @@ __all__ = [
     "demo",
     "load",
     "skin_file",
+    "transfer",
+    "transfer_file",
 ]
