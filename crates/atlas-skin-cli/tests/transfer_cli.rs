@@ -86,10 +86,7 @@ fn a_cape_given_as_obj_is_added_skinned() {
     assert_eq!(target["name"], "cape");
     assert_eq!(target["counts"]["stored_vertices"], vertices);
     assert!(target["counts"]["matched"].as_u64().unwrap() > 0);
-    assert_eq!(
-        target["vertex_sources"].as_array().unwrap().len(),
-        vertices
-    );
+    assert_eq!(target["vertex_sources"].as_array().unwrap().len(), vertices);
     assert!(std::fs::metadata(&html).unwrap().len() > 10_000);
     let validation = node_check("validate.mjs", &[&glb]);
     assert_eq!(validation[0]["errors"], 0, "{}", validation[0]);
@@ -133,9 +130,11 @@ fn assert_refused(args: &[&std::ffi::OsStr], out: &Path, file: &Path, what: &str
     assert!(!out.exists());
     let dir = out.parent().unwrap();
     assert!(
-        std::fs::read_dir(dir)
+        std::fs::read_dir(dir).unwrap().all(|e| !e
             .unwrap()
-            .all(|e| !e.unwrap().file_name().to_string_lossy().ends_with(".tmp")),
+            .file_name()
+            .to_string_lossy()
+            .ends_with(".tmp")),
         "a temporary file was left"
     );
 }
@@ -146,10 +145,20 @@ fn bad_input_is_refused_with_the_file_named() {
     let out = dir.join("out.glb");
     let far = dir.join("far.obj");
     write_mesh_obj("Knight_Cape", [0.0, 0.0, 30.0], 1.0, &far);
-    assert_refused(&[knight().as_os_str(), far.as_os_str()], &out, &far, "rest space");
+    assert_refused(
+        &[knight().as_os_str(), far.as_os_str()],
+        &out,
+        &far,
+        "rest space",
+    );
     let large = dir.join("centimetres.obj");
     write_mesh_obj("Knight_Cape", [0.0; 3], 100.0, &large);
-    assert_refused(&[knight().as_os_str(), large.as_os_str()], &out, &large, "times the size");
+    assert_refused(
+        &[knight().as_os_str(), large.as_os_str()],
+        &out,
+        &large,
+        "times the size",
+    );
     let empty = dir.join("empty.obj");
     std::fs::write(&empty, "v 0 0 0\nv 1 0 0\nv 0 1 0\n").unwrap();
     let output = atlas_skin(&[
@@ -160,7 +169,10 @@ fn bad_input_is_refused_with_the_file_named() {
         out.as_os_str(),
     ]);
     let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(!output.status.success() && stderr.contains("empty.obj"), "{stderr}");
+    assert!(
+        !output.status.success() && stderr.contains("empty.obj"),
+        "{stderr}"
+    );
     assert!(!out.exists());
     // A source without weights: a bare mesh with a skeleton file.
     let cape = dir.join("cape.obj");
