@@ -140,7 +140,7 @@ fn hash_of(bytes: &[u8]) -> u64 {
 }
 
 /// Jobs handed to one process.
-const JOBS_PER_PROCESS: usize = 40;
+pub const JOBS_PER_PROCESS: usize = 40;
 
 /// Runs `peer` on every job whose answer is not cached (in batches of
 /// [`JOBS_PER_PROCESS`]) and returns every job's answer by key.
