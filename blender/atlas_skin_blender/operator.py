@@ -12,6 +12,19 @@ from .package import MissingPackage, atlas_skin
 from .rig import RigError, deforming_rig
 
 
+def polled(cls, context, find):
+    """An operator's poll: Object Mode and a selection `find(context)` accepts (else the
+    sentence it returns is shown as the reason)."""
+    if context.mode != "OBJECT":
+        cls.poll_message_set("works in Object Mode")
+        return False
+    found = find(context)
+    if isinstance(found, str):
+        cls.poll_message_set(found)
+        return False
+    return True
+
+
 def selection(context):
     """(armature, meshes) of the selection, or a sentence saying what is missing."""
     selected = context.selected_objects
@@ -80,14 +93,7 @@ class OBJECT_OT_parent_atlas_skin(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        if context.mode != "OBJECT":
-            cls.poll_message_set("works in Object Mode")
-            return False
-        found = selection(context)
-        if isinstance(found, str):
-            cls.poll_message_set(found)
-            return False
-        return True
+        return polled(cls, context, selection)
 
     def execute(self, context):
         armature, meshes = selection(context)

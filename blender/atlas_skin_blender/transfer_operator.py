@@ -10,6 +10,7 @@ from bpy.props import BoolProperty, FloatProperty, IntProperty
 
 from .binding import bind_to_armature, write_groups
 from .body import BodyError, read_body, rest_state
+from .operator import polled
 from .package import MissingPackage, atlas_skin
 from .rig import RigError, deforming_rig
 
@@ -95,14 +96,7 @@ class OBJECT_OT_transfer_atlas_skin(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        if context.mode != "OBJECT":
-            cls.poll_message_set("works in Object Mode")
-            return False
-        found = skinned_source(context)
-        if isinstance(found, str):
-            cls.poll_message_set(found)
-            return False
-        return True
+        return polled(cls, context, skinned_source)
 
     def execute(self, context):
         source, armature, targets = skinned_source(context)

@@ -119,6 +119,7 @@ impl Operators {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fixtures::shapes::quad_grid;
 
     fn mesh(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> SurfaceMesh {
         SurfaceMesh {
@@ -172,13 +173,8 @@ mod tests {
             }
         }
         let mut triangles = Vec::new();
-        for y in 0..ny - 1 {
-            for x in 0..nx - 1 {
-                let v = y * nx + x;
-                triangles.push([v, v + 1, v + nx + 1]);
-                triangles.push([v, v + nx + 1, v + nx]);
-            }
-        }
+        let index = |y: usize, x: usize| y as u32 * nx + x as u32;
+        quad_grid((ny - 1) as usize, (nx - 1) as usize, index, &mut triangles);
         let m = mesh(&positions, &triangles);
         let ops = Operators::new(&m);
         let f = |p: DVec3| 2.0 * p.x - 3.0 * p.y + 1.0;

@@ -4,7 +4,7 @@
 
 use super::inpaint::{dense_reference, System, FIXED};
 use super::*;
-use crate::fixtures::shapes::{capsule_chain, uv_sphere};
+use crate::fixtures::shapes::{capsule_chain, quad_grid, uv_sphere};
 use glam::DVec3;
 use std::f64::consts::TAU;
 
@@ -162,13 +162,7 @@ fn constant_weights_are_carried_exactly() {
         })
         .collect();
     let mut triangles = Vec::new();
-    for y in 0..n - 1 {
-        for x in 0..n - 1 {
-            let v = y * n + x;
-            triangles.push([v, v + 1, v + n + 1]);
-            triangles.push([v, v + n + 1, v + n]);
-        }
-    }
+    quad_grid((n - 1) as usize, (n - 1) as usize, |y, x| y as u32 * n + x as u32, &mut triangles);
     let result = transfer_weights(&source, &plane, &triangles, &TransferParams::default()).unwrap();
     assert!(result.counts.matched > 0 && result.counts.inpainted > result.counts.matched);
     for v in 0..plane.len() {
