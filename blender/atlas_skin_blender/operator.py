@@ -74,6 +74,20 @@ class OBJECT_OT_parent_atlas_skin(bpy.types.Operator):
         ),
         default="POU",
     )
+    binding: EnumProperty(
+        name="Binding",
+        description="Blended weights, or one bone per vertex for a character bound rigidly",
+        items=(
+            ("SMOOTH", "Smooth", "Blended weights: a vertex may follow several bones"),
+            (
+                "RIGID",
+                "Rigid",
+                "One bone per vertex, weight 1: the same parts, each vertex moving with the "
+                "deepest bone whose branch holds more than half of its blended weights",
+            ),
+        ),
+        default="SMOOTH",
+    )
     force: StringProperty(
         name="Force Boundaries",
         description="Bones that get a boundary where the rules would give none "
@@ -86,7 +100,7 @@ class OBJECT_OT_parent_atlas_skin(bpy.types.Operator):
     )
     use_tails: BoolProperty(
         name="Bone Tails",
-        description="Leaf bones end at their tails (face bones move a patch of skin); off, "
+        description="Leaf bones end at their tails; off, "
         "bones are their heads only, as in a glTF file, whose tails Blender's importer guesses",
         default=True,
     )
@@ -152,6 +166,7 @@ class OBJECT_OT_parent_atlas_skin(bpy.types.Operator):
             "overlap_joints": bone_factors(self.bone_overlap, bone_names, "Per-Bone Overlap"),
             "max_influences": self.max_influences,
             "blend": self.blend.lower(),
+            "binding": self.binding.lower(),
             "force": bone_list(self.force, bone_names, "Force Boundaries"),
             "forbid": bone_list(self.forbid, bone_names, "Forbid Boundaries"),
         }

@@ -155,6 +155,7 @@ def check_options(path):
     cases = [
         ({"max_influences": 2}, ["--max-influences", "2"]),
         ({"blend": "PAPER"}, ["--blend", "paper"]),
+        ({"binding": "RIGID"}, ["--binding", "rigid"]),
         (
             {"overlap": 0.25, "bone_overlap": "lowerarm_l=1.5, upleg_r = 0.1"},
             ["--overlap", "0.25", "--overlap-joint", "lowerarm_l=1.5", "--overlap-joint",
@@ -170,8 +171,13 @@ def check_options(path):
         strip_weights(meshes)
         assert run_operator(armature, meshes, use_tails=False, **options) == {"FINISHED"}
         names = deforming_names(armature)
-        check_groups(f"demo {options}", meshes, names, options.get("max_influences", 4))
+        rigid = options.get("binding") == "RIGID"
+        influences = 1 if rigid else options.get("max_influences", 4)
+        check_groups(f"demo {options}", meshes, names, influences)
         check_matches_cli(f"demo {options}", meshes, names, cli_names, cli)
+        if rigid:
+            weights = np.concatenate([bone_weights(o, names) for o in meshes])
+            assert set(np.unique(weights)) == {0.0, 1.0}, "a rigid weight other than 0 or 1"
         differs = np.abs(np.concatenate([bone_weights(o, names) for o in meshes]) - default).max()
         assert differs > 0.01, f"{options} change nothing"
         print(f"options {options}: same as `atlas-skin skin {' '.join(flags)}`; "

@@ -100,6 +100,7 @@ fn reference_weights_as_candidate_give_zeros_and_the_json_contract_holds() {
                 "joint_matches",
                 "joints",
                 "matched",
+                "rignet",
                 "validity",
                 "vertices",
                 "weights_l1"

@@ -18,7 +18,12 @@ fn demo_and_skinned_corpus_outputs_add_no_validator_issues() {
 
     atlas_skin_ok(&["demo", "-o", &path("")]);
     atlas_skin_ok(&["skin", "-o", &path("demo-skinned.glb")]);
-    let demo_outputs = [dir.join("demo.glb"), dir.join("demo-skinned.glb")];
+    atlas_skin_ok(&["skin", "--binding", "rigid", "-o", &path("demo-rigid.glb")]);
+    let demo_outputs = [
+        dir.join("demo.glb"),
+        dir.join("demo-skinned.glb"),
+        dir.join("demo-rigid.glb"),
+    ];
     for report in validator_reports(&demo_outputs) {
         assert_no_new_issues(&report, None);
     }

@@ -10,12 +10,14 @@
 pub mod bleeding;
 pub mod deform;
 pub mod matching;
+pub mod rignet_metrics;
 pub mod validity;
 pub mod weights_l1;
 pub mod worst;
 
 pub use bleeding::Bleeding;
 pub use deform::{DeformError, Skinning};
+pub use rignet_metrics::RigNetMetrics;
 pub use validity::Validity;
 pub use weights_l1::WeightsL1;
 pub use worst::{JointWeight, WorstVertex};
@@ -157,6 +159,10 @@ pub struct Evaluation {
     #[serde(default)]
     pub joint_matches: Vec<matching::JointPair>,
     pub weights_l1: WeightsL1,
+    /// RigNet's precision, recall and L1 of the weights as written ([`rignet_metrics`];
+    /// absent from JSON written before it was measured).
+    #[serde(default)]
+    pub rignet: Option<RigNetMetrics>,
     /// LBS in random poses.
     pub deform_random: DeformError,
     /// DQS in the same random poses.
@@ -237,6 +243,11 @@ pub fn evaluate(input: &EvalInput, options: &EvalOptions) -> Result<Evaluation, 
         candidate_joints: candidate.skeleton.len(),
         joint_matches: aligned.joint_matches,
         weights_l1: weights_l1::weights_l1(&aligned.reference, &aligned.candidate, joints),
+        rignet: Some(rignet_metrics::rignet_metrics(
+            &aligned.reference_as_stored,
+            &aligned.candidate,
+            joints,
+        )),
         deform_random: random_lbs.total,
         deform_random_dqs: deform_with(&random_palettes, Skinning::DualQuaternion).total,
         deform_anim: input.animation.map(|animation| {
@@ -284,6 +295,8 @@ struct Aligned {
     rest_positions: Vec<Vec3>,
     /// #M reference rows, pruned and renormalised.
     reference: VertexWeights,
+    /// #M reference rows as stored (neither pruned nor renormalised).
+    reference_as_stored: VertexWeights,
     /// #M candidate rows as stored, joints renumbered to the reference's.
     candidate: VertexWeights,
     /// #M welded surface vertex of each row.
@@ -339,6 +352,9 @@ fn align(input: &EvalInput, options: &EvalOptions, diagonal: f64) -> Result<Alig
         stored_of_row: pairs.iter().map(|&(r, _)| r).collect(),
         rest_positions: pairs.iter().map(|&(r, _)| reference.positions[r]).collect(),
         reference: VertexWeights::from_rows(pairs.iter().map(|&(r, _)| reference_stored.row(r))),
+        reference_as_stored: VertexWeights::from_rows(
+            pairs.iter().map(|&(r, _)| reference.weights.row(r)),
+        ),
         candidate: VertexWeights::from_rows(pairs.iter().map(|&(_, c)| {
             candidate
                 .weights

@@ -21,9 +21,9 @@ pub fn stage_timings(skinned: &Skinned) -> Map<String, Value> {
         .collect()
 }
 
-/// The JSON report: `decomposition` (the decomposition's own report, each joint with its
-/// `overlap_width` and cut `curve`, and the region of every stored vertex),
-/// `timings_ms`, `counts`, `pieces` (how each piece and each stored vertex was weighted, see
+/// The JSON report: `binding` (`smooth` or `rigid`), `decomposition` (the decomposition's
+/// own report, each joint with its `overlap_width` and cut `curve`, and the region of every
+/// stored vertex), `timings_ms`, `counts`, `pieces` (how each piece and each stored vertex was weighted, see
 /// [`TREATMENTS`]), `warnings`.
 ///
 /// - `input`: the character's name (its path, as displayed).
@@ -44,6 +44,7 @@ pub fn skin_report(
 /// order of [`serde_json::Map`]: each struct below declares its fields in that order).
 #[derive(Serialize)]
 pub struct SkinReport<'a> {
+    binding: &'static str,
     counts: ReportCounts,
     decomposition: ReportDecomposition,
     input: &'a str,
@@ -61,14 +62,11 @@ struct ReportCounts {
     far_bone_vertices: usize,
     inside_out_pieces: usize,
     joints: usize,
-    leaf_patches: usize,
     max_influences: usize,
     off_carrier_vertices: usize,
     regions: usize,
     sibling_blend_vertices: usize,
     surface_vertices: usize,
-    twins_given_a_share: usize,
-    twins_too_many_to_share: usize,
     unreachable_vertices: usize,
     vertices: usize,
     welded_vertices: usize,
@@ -78,7 +76,6 @@ struct ReportCounts {
 /// vertex's region, fields in sorted order.
 #[derive(Serialize)]
 struct ReportDecomposition {
-    bone_axis: Option<String>,
     cuts: usize,
     joints: Vec<ReportJoint>,
     regions: Vec<ReportRegion>,
@@ -168,20 +165,18 @@ impl<'a> SkinReport<'a> {
         let weight_counts = &counts.weights;
         let warnings = report_warnings(input_warnings, skinned);
         Self {
+            binding: skinned.binding.name(),
             counts: ReportCounts {
                 duplicate_faces: counts.duplicate_faces,
                 fallback_weighted_vertices: counts.unreferenced_stored_vertices,
                 far_bone_vertices: weight_counts.far_bone_vertices,
                 inside_out_pieces: counts.inside_out_pieces,
                 joints: counts.joints,
-                leaf_patches: weight_counts.leaf_patches.len(),
                 max_influences: skinned.weights.max_influences(),
                 off_carrier_vertices: weight_counts.off_carrier,
                 regions: decomposition.regions.len(),
                 sibling_blend_vertices: weight_counts.sibling_blend_vertices,
                 surface_vertices: counts.surface_vertices,
-                twins_given_a_share: weight_counts.twins_given_a_share.len(),
-                twins_too_many_to_share: weight_counts.twins_too_many_to_share,
                 unreachable_vertices: weight_counts.unreachable,
                 vertices: counts.stored_vertices,
                 welded_vertices: counts.welded_vertices,
@@ -300,7 +295,6 @@ impl ReportDecomposition {
             })
             .collect();
         ReportDecomposition {
-            bone_axis: report.bone_axis,
             cuts: report.cuts,
             joints,
             regions,
@@ -540,6 +534,7 @@ mod tests {
         let warnings = report_warnings(input_warnings, skinned);
         json!({
             "input": input,
+            "binding": skinned.binding.name(),
             "decomposition": decomposition_json,
             "timings_ms": timings,
             "counts": {
@@ -551,11 +546,8 @@ mod tests {
                 "unreachable_vertices": weight_counts.unreachable,
                 "fallback_weighted_vertices": counts.unreferenced_stored_vertices,
                 "max_influences": skinned.weights.max_influences(),
-                "leaf_patches": weight_counts.leaf_patches.len(),
                 "far_bone_vertices": weight_counts.far_bone_vertices,
                 "sibling_blend_vertices": weight_counts.sibling_blend_vertices,
-                "twins_given_a_share": weight_counts.twins_given_a_share.len(),
-                "twins_too_many_to_share": weight_counts.twins_too_many_to_share,
                 "off_carrier_vertices": weight_counts.off_carrier,
                 "duplicate_faces": counts.duplicate_faces,
                 "inside_out_pieces": counts.inside_out_pieces,

@@ -3,6 +3,7 @@
 
 use atlas_skin::pipeline::SkinParams;
 use atlas_skin::weights::blend::Blend;
+use atlas_skin::weights::rigid::Binding;
 use atlas_skin_io::gltf::MAX_INFLUENCES;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -33,7 +34,7 @@ pub enum SettingsError {
 #[derive(Debug, Clone, Default)]
 pub struct Settings {
     /// A settings file: [`SkinParams`] as JSON (any subset of `decompose`, `overlap`
-    /// {`factor`, `per_joint`}, `blend`, `max_influences`).
+    /// {`factor`, `per_joint`}, `blend`, `binding`, `max_influences`).
     pub config: Option<PathBuf>,
     /// Overlap half-width as a multiple of each boundary's diameter.
     pub overlap: Option<f64>,
@@ -41,6 +42,8 @@ pub struct Settings {
     pub overlap_joints: Vec<(String, f64)>,
     /// How overlapping regions are blended.
     pub blend: Option<Blend>,
+    /// Blended weights or one joint per vertex.
+    pub binding: Option<Binding>,
     /// Joints given a boundary even where the rules would not.
     pub force: Vec<String>,
     /// Joints given no boundary.
@@ -79,6 +82,9 @@ impl Settings {
         if let Some(blend) = self.blend {
             params.blend = blend;
         }
+        if let Some(binding) = self.binding {
+            params.binding = binding;
+        }
         if let Some(n) = self.max_influences {
             params.max_influences = n;
         }
@@ -108,6 +114,7 @@ mod tests {
             overlap: Some(0.25),
             overlap_joints: vec![("elbow".into(), 0.1)],
             blend: Some(Blend::Paper),
+            binding: Some(Binding::Rigid),
             force: vec!["neck".into()],
             max_influences: Some(2),
             ..Settings::default()
@@ -116,6 +123,7 @@ mod tests {
         assert_eq!(params.overlap.factor, 0.25);
         assert_eq!(params.overlap.per_joint["elbow"], 0.1);
         assert_eq!(params.blend, Blend::Paper);
+        assert_eq!(params.binding, Binding::Rigid);
         assert_eq!(params.max_influences, 2);
         assert!(params.decompose.force.contains(&"neck".to_string()));
         assert_eq!(Settings::default().params().unwrap(), SkinParams::default());

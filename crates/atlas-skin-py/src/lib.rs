@@ -12,6 +12,7 @@ use crate::errors::{no_panic, to_py_err, transfer_to_py_err};
 use atlas_skin::pipeline::{skin, SkinInput};
 use atlas_skin::transfer::{transfer_weights, TransferParams, TransferSource};
 use atlas_skin::weights::blend::Blend;
+use atlas_skin::weights::rigid::Binding;
 use atlas_skin_io::gltf::MAX_INFLUENCES;
 use atlas_skin_io::{Character, LoadOptions};
 use atlas_skin_job::batch::{
@@ -56,15 +57,13 @@ fn method_settings(options: Option<&Bound<'_, PyDict>>) -> PyResult<Settings> {
             }
             "blend" => {
                 let name: String = value.extract().map_err(wrong_type)?;
-                settings.blend = Some(match name.as_str() {
-                    "pou" => Blend::PartitionOfUnity,
-                    "paper" => Blend::Paper,
-                    other => {
-                        return Err(PyValueError::new_err(format!(
-                            "blend must be \"pou\" or \"paper\", got {other:?}"
-                        )))
-                    }
-                });
+                let choices = [("pou", Blend::PartitionOfUnity), ("paper", Blend::Paper)];
+                settings.blend = Some(one_of("blend", &name, &choices)?);
+            }
+            "binding" => {
+                let name: String = value.extract().map_err(wrong_type)?;
+                let choices = [("smooth", Binding::Smooth), ("rigid", Binding::Rigid)];
+                settings.binding = Some(one_of("binding", &name, &choices)?);
             }
             "force" => settings.force = value.extract().map_err(wrong_type)?,
             "forbid" => settings.forbid = value.extract().map_err(wrong_type)?,
@@ -84,6 +83,18 @@ fn method_settings(options: Option<&Bound<'_, PyDict>>) -> PyResult<Settings> {
         }
     }
     Ok(settings)
+}
+
+/// The value of `choices` named `name`, or a `ValueError` naming the option `key` and
+/// its two choices (`blend must be "pou" or "paper", got "linear"`).
+fn one_of<T: Copy>(key: &str, name: &str, choices: &[(&str, T); 2]) -> PyResult<T> {
+    match choices.iter().find(|(n, _)| *n == name) {
+        Some(&(_, value)) => Ok(value),
+        None => Err(PyValueError::new_err(format!(
+            "{key} must be \"{}\" or \"{}\", got {name:?}",
+            choices[0].0, choices[1].0
+        ))),
+    }
 }
 
 /// A Python object from JSON (through the `json` module: dicts, lists, str, int, float).

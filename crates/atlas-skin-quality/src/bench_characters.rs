@@ -1,7 +1,12 @@
 //! Which characters the benchmark runs and how each is given to `atlas-skin`: every glTF
-//! binary under `shared/data/bench/*/` (the artist weights are in the file), and every
-//! corpus model of `shared/data/models` with reference weights (the corpus table of
-//! `atlas-skin-corpus`).
+//! binary under `shared/data/bench/*/` and `shared/data/bench-large/*/` (the artist weights
+//! are in the file), and every corpus model of `shared/data/models` with reference weights
+//! (the corpus table of `atlas-skin-corpus`).
+//!
+//! The sets form the three groups a change to the method is judged on: **tune** (`bench/`
+//! and `bench-large/rignet-train/`: rules and widths may be chosen looking at them),
+//! **check** (`bench-large/rignet-check/`: a change is confirmed there, never chosen there)
+//! and the clean **corpus**.
 
 use anyhow::{Context, Result};
 use atlas_skin_corpus::{Reference, MODELS};
@@ -10,14 +15,63 @@ use serde::{Deserialize, Serialize};
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 
-/// The two sets of characters.
+/// The sets of characters, each a folder of `shared/data`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Set {
-    /// `shared/data/bench`: game characters as they come, scored against bench/BASELINES.md.
+    /// `shared/data/bench`: 65 game characters as they come, with bench/BASELINES.md's rows.
     Bench,
-    /// `shared/data/models`: the clean corpus, scored against BASELINES.md.
+    /// `shared/data/bench-large/rignet-train`: 400 more of the same dataset, to tune on.
+    Train,
+    /// `shared/data/bench-large/rignet-check`: 210 more, to confirm on, never to tune on.
+    Check,
+    /// `shared/data/models`: the clean corpus, with BASELINES.md's rows.
     Models,
+}
+
+/// What a set is for: the groups a change is judged on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Group {
+    /// `bench` and `rignet-train`.
+    Tune,
+    /// `rignet-check`.
+    Check,
+    /// The clean corpus.
+    Corpus,
+}
+
+impl Group {
+    pub const ALL: [Group; 3] = [Group::Tune, Group::Check, Group::Corpus];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Group::Tune => "tune",
+            Group::Check => "check",
+            Group::Corpus => "corpus",
+        }
+    }
+}
+
+impl Set {
+    /// The group the set belongs to.
+    pub fn group(self) -> Group {
+        match self {
+            Set::Bench | Set::Train => Group::Tune,
+            Set::Check => Group::Check,
+            Set::Models => Group::Corpus,
+        }
+    }
+
+    /// The set's folder under `shared/data`.
+    pub fn folder(self) -> &'static str {
+        match self {
+            Set::Bench => "bench",
+            Set::Train => "bench-large/rignet-train",
+            Set::Check => "bench-large/rignet-check",
+            Set::Models => "models",
+        }
+    }
 }
 
 /// One character to skin and judge.
@@ -49,23 +103,49 @@ pub fn bench_characters(bench: &Path) -> Result<Vec<Character>> {
         .filter(|p| p.is_dir())
         .collect();
     folders.sort();
-    let mut characters = Vec::new();
-    for folder in folders {
-        let rigid = rigid_bindings(&folder.join("manifest.json"))?;
-        let mut files: Vec<PathBuf> = read_dir(&folder)?
-            .into_iter()
-            .filter(|p| p.extension().is_some_and(|e| e == "glb"))
-            .collect();
-        files.sort_by_key(|p| natural_key(p));
-        let folder_name = folder.file_name().unwrap_or_default().to_string_lossy();
-        for input in files {
+    let characters = folders
+        .iter()
+        .map(|folder| folder_characters(folder, Set::Bench))
+        .collect::<Result<Vec<_>>>()?
+        .concat();
+    if characters.is_empty() {
+        anyhow::bail!("no .glb file in the subfolders of {}", bench.display());
+    }
+    Ok(characters)
+}
+
+/// Every `*.glb` of `data/bench-large/rignet-train` (`set` [`Set::Train`]) or
+/// `rignet-check` ([`Set::Check`]), named `rignet-train/53.glb`, with the manifest's rigid
+/// flags.
+pub fn large_characters(data: &Path, set: Set) -> Result<Vec<Character>> {
+    debug_assert!(matches!(set, Set::Train | Set::Check));
+    let folder = data.join(set.folder());
+    let characters = folder_characters(&folder, set)?;
+    if characters.is_empty() {
+        anyhow::bail!("no .glb file in {}", folder.display());
+    }
+    Ok(characters)
+}
+
+/// The `*.glb` files of one folder, in natural order, named `<folder>/<file>`.
+fn folder_characters(folder: &Path, set: Set) -> Result<Vec<Character>> {
+    let rigid = rigid_bindings(&folder.join("manifest.json"))?;
+    let mut files: Vec<PathBuf> = read_dir(folder)?
+        .into_iter()
+        .filter(|p| p.extension().is_some_and(|e| e == "glb"))
+        .collect();
+    files.sort_by_key(|p| natural_key(p));
+    let folder_name = folder.file_name().unwrap_or_default().to_string_lossy();
+    Ok(files
+        .into_iter()
+        .map(|input| {
             let file = input
                 .file_name()
                 .unwrap_or_default()
                 .to_string_lossy()
                 .to_string();
-            characters.push(Character {
-                set: Set::Bench,
+            Character {
+                set,
                 name: format!("{folder_name}/{file}"),
                 skin_args: vec![input.clone().into_os_string()],
                 reference_args: vec![input.clone().into_os_string()],
@@ -73,13 +153,9 @@ pub fn bench_characters(bench: &Path) -> Result<Vec<Character>> {
                 prune_reference: None,
                 rigid_by_artist: rigid.iter().find(|(f, _)| f == &file).map(|r| r.1),
                 input,
-            });
-        }
-    }
-    if characters.is_empty() {
-        anyhow::bail!("no .glb file in the subfolders of {}", bench.display());
-    }
-    Ok(characters)
+            }
+        })
+        .collect())
 }
 
 /// The corpus models of `models` that have reference weights, in the corpus table's order.

@@ -112,6 +112,8 @@ pub fn render(
             "\n{}:",
             match set {
                 Set::Bench => "bench",
+                Set::Train => "rignet-train",
+                Set::Check => "rignet-check",
                 Set::Models => "models (clean corpus)",
             }
         );

@@ -6,6 +6,7 @@
 
 use crate::bench_baselines::{BaselineTable, Figures};
 use crate::bench_characters::{Character, Set};
+use crate::computed_baselines::{compute_baselines, Baselines};
 use crate::gltf_skins::skinned_meshes;
 use crate::run::{run_eval, run_skin, SkinRun};
 use crate::scoring::Pair;
@@ -144,6 +145,9 @@ pub struct CharacterResult {
     /// As the manifest says; `None` where none tells.
     pub rigid_by_artist: Option<bool>,
     pub outcome: Outcome,
+    /// The baselines computed under the same poses (none in runs written before them).
+    #[serde(default)]
+    pub baselines: Baselines,
 }
 
 impl CharacterResult {
@@ -292,6 +296,7 @@ pub fn run_character(
         name: character.name.clone(),
         rigid_by_artist: character.rigid_by_artist,
         outcome,
+        baselines: compute_baselines(exe, character, work, settings),
     }
 }
 
@@ -301,6 +306,7 @@ fn score(exe: &Path, character: &Character, work: &Path, settings: &Settings) ->
     let stem = work
         .join(match character.set {
             Set::Bench => "bench",
+            Set::Train | Set::Check => "bench-large",
             Set::Models => "models",
         })
         .join(character.name.trim_end_matches(".glb"));
@@ -410,6 +416,7 @@ pub(crate) mod tests {
             set: Set::Bench,
             name: name.to_string(),
             rigid_by_artist: Some(false),
+            baselines: Baselines::default(),
             outcome: Outcome::Scored(Box::new(Scored {
                 evaluation: Evaluation {
                     vertices: 100,
@@ -424,6 +431,7 @@ pub(crate) mod tests {
                         max: 1.5,
                         dominant_agreement: 0.9,
                     },
+                    rignet: None,
                     deform_random: deform,
                     deform_random_dqs: deform,
                     deform_anim: None,
@@ -461,6 +469,7 @@ pub(crate) mod tests {
             set: Set::Bench,
             name: name.to_string(),
             rigid_by_artist: Some(true),
+            baselines: Baselines::default(),
             outcome: Outcome::Failed {
                 stage: "skin".into(),
                 reason: "the mesh has no triangles".into(),
@@ -561,6 +570,18 @@ pub(crate) mod tests {
                 assert_ne!(other.deform, s.evaluation.deform_random);
             }
             assert!(s.skin.vertices > 0 && s.skin.weights_seconds.is_some());
+            let rignet = s.evaluation.rignet.expect("RigNet's metrics");
+            assert!(rignet.vertices > 0 && (0.0..=1.0).contains(&rignet.precision));
+            assert!((0.0..=1.0).contains(&rignet.recall) && rignet.l1 >= 0.0);
+            // Nearest bone is computed here, under the same poses; bone heat only where
+            // scripts/bone-heat has run (not in this fresh folder).
+            let nearest = result
+                .baselines
+                .scored(crate::computed_baselines::Baseline::NearestBone)
+                .unwrap_or_else(|| panic!("no nearest-bone figures: {:?}", result.baselines));
+            assert!(nearest.deform.mean > 0.0 && nearest.other_poses.len() == OTHER_SEEDS.len());
+            assert_eq!(nearest.rignet.map(|r| r.vertices), Some(rignet.vertices));
+            assert_eq!(result.baselines.bone_heat, None);
             let artist = s.skin.reference_single_joint_share.unwrap();
             if result.rigid_by_artist == Some(true) {
                 assert_eq!(artist, 1.0, "{}", result.name);

@@ -263,6 +263,7 @@ mod tests {
                 max: 0.3,
                 dominant_agreement: 0.9,
             },
+            rignet: None,
             deform_random: DeformError { mean, max },
             deform_random_dqs: DeformError { mean, max },
             deform_anim: None,

@@ -115,8 +115,14 @@ fn overlap_stage(bencher: Bencher, name: &str) {
 fn weights_stage(bencher: Bencher, name: &str) {
     let c = prepared(name);
     bencher.bench(|| {
-        compute_weights(&c.decomposition, &c.skeleton, &c.overlaps, Blend::default())
-            .expect("weights")
+        compute_weights(
+            &c.decomposition,
+            &c.skeleton,
+            &c.overlaps,
+            Blend::default(),
+            &Default::default(),
+        )
+        .expect("weights")
     });
 }
 

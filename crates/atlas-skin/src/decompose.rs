@@ -24,7 +24,6 @@ use crate::regions::{
     bind_parent_sides, bind_regions, faces_by_region, grow_regions, nearest_bone_joints,
     side_regions,
 };
-use crate::skeleton::bone_axis::infer_bone_axis;
 use crate::skeleton::bone_tree::BoneTree;
 use crate::skeleton::bones::{bone_segments, joint_pairs, BoneIndex};
 use atlas_skin_runtime::Skeleton;
@@ -52,7 +51,6 @@ pub fn decompose(
     let vertex_snap = vertex_snap_distances(mesh, topology, params.snap_fraction);
     let bones = BoneIndex::new(joint_pairs(skeleton, &positions), &positions);
     let children = skeleton.children();
-    let bone_axis = infer_bone_axis(skeleton, &positions, &children);
     let plans = plan_joints(
         mesh,
         &topology.vertex_component,
@@ -61,7 +59,6 @@ pub fn decompose(
         &positions,
         &bones,
         &overrides,
-        bone_axis,
         params,
     );
     let cut_surface = CutSurface {
@@ -79,6 +76,7 @@ pub fn decompose(
         &plans,
         &searches,
         params.snap_fraction,
+        &params.rules_off,
     );
 
     let curves: Vec<_> = placements
@@ -193,7 +191,6 @@ pub fn decompose(
         boundaries,
         joints,
         shared_sides,
-        bone_axis,
         surface_spheres,
     })
 }
@@ -380,9 +377,7 @@ fn search_all_cuts(surface: &CutSurface, bones: &BoneIndex, plans: &[JointPlan])
         .map_init(
             || pool.lend(),
             |scratch, (j, plan)| match plan {
-                JointPlan::Boundary(frame)
-                | JointPlan::Soft(frame, _)
-                | JointPlan::CutOrSkip(frame, _) => {
+                JointPlan::Boundary(frame) | JointPlan::Soft(frame, _) => {
                     find_cut_candidates(surface, j, frame, bones, scratch)
                 }
                 JointPlan::Skip(_) | JointPlan::Exclude(_) => CutSearch::default(),

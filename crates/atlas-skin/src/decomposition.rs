@@ -3,7 +3,6 @@
 
 use crate::mesh::{FaceSpheres, SurfaceMesh, Topology};
 use crate::regions::shared_sides::SharedSide;
-use crate::skeleton::bone_axis::BoneAxis;
 use glam::DVec3;
 use serde::Serialize;
 use std::sync::OnceLock;
@@ -28,10 +27,6 @@ pub struct Decomposition {
     /// Regions that were the child side of the cuts of unrelated joints (a hand fused to
     /// the hip) and were divided among them ([`crate::regions::shared_sides`]).
     pub shared_sides: Vec<SharedSide>,
-    /// The local axis of the skeleton's bind frames that runs along its bones, which gave
-    /// joints without child bones their direction ([`crate::skeleton::bone_axis`]); `None`
-    /// when the frames have none (their directions continue their parents' bones).
-    pub bone_axis: Option<BoneAxis>,
     /// The face index of `surface`, built by the first [`Decomposition::surface_spheres`]
     /// (the holding regions of soft joints and the guard against far bones share it);
     /// empty (`OnceLock::new()`) when the decomposition is made.
@@ -89,7 +84,7 @@ pub struct Boundary {
     /// Region on the child bone's side.
     pub child_region: u32,
     /// The joint is a leaf whose part runs on past it for at least its bone's length (rule
-    /// 5 (d) of [`crate::cuts::joint_roles`]): a soft boundary of it is seeded farther
+    /// 5 (c) of [`crate::cuts::joint_roles`]): a soft boundary of it is seeded farther
     /// ([`crate::cuts::joint_roles::JointFrame::leaf_part_past`]).
     pub leaf_part_past: bool,
     /// Another bone runs through the joint (or from it) and crosses every plane searched

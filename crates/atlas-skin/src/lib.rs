@@ -11,11 +11,12 @@
 //! | regions of the split surface, the joints bound to them | §3.2 | [`regions`] |
 //! | the decomposition driver (§3.1 then §3.2) and its result | §3.1–3.2 | [`decompose()`], [`decomposition`] |
 //! | overlaps: surface distances from each cut, widths | §3.3 | [`overlap`] |
-//! | weights: blending, chains, soft boundaries, patches | §4, §5 | [`weights`] |
+//! | weights: blending, chains, soft boundaries | §4, §5 | [`weights`] |
 //! | what the report shows of a decomposition | | [`report`] |
 //! | weights carried from a skinned surface onto other meshes (Abdrashitov et al. 2023) | | [`transfer`] |
 //! | shapes with known answers and the demo character | | [`fixtures`] |
 
+pub mod ablation;
 pub mod cuts;
 pub mod decompose;
 pub mod decomposition;

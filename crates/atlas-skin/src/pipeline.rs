@@ -4,13 +4,14 @@
 //! checked against the mesh ([`crate::skeleton::placement`]) and given a hierarchy when it
 //! has several roots ([`crate::skeleton::hierarchy`]) → decomposition (§3.1 cuts, §3.2 regions:
 //! [`crate::decompose()`]) → overlaps (§3.3: [`crate::overlap`]) → weights (§4, §5:
-//! [`crate::weights`], with the guard against far bones, [`crate::weights::guard`]) →
-//! un-weld (weights per stored vertex, pruned to `max_influences`).
+//! [`crate::weights`], with the guard against far bones, [`crate::weights::guard`]; one
+//! joint per vertex when bound rigidly, [`crate::weights::rigid`]) → un-weld (weights per stored vertex, pruned to `max_influences`).
 //! Settings are validated once, before any work; each stage's wall time is measured here.
 //!
 //! Inputs: a [`SkinInput`] (stored positions and triangles, the skeleton in the mesh's bind
 //! space, the joints the input marks as end points) and [`SkinParams`]. Output: [`Skinned`].
 
+use crate::ablation::RulesOff;
 use crate::decompose::{decompose, DecomposeError, DecomposeParams};
 use crate::decomposition::Decomposition;
 use crate::mesh::duplicate_faces::remove_duplicate_faces;
@@ -21,9 +22,9 @@ use crate::overlap::{compute_overlaps, OverlapError, OverlapParams, Overlaps};
 use crate::rows::{Rows, PAR_CHUNK};
 use crate::skeleton::bones::{bone_segments, capped_extensions, nearest_bone, EXTENSION_JOINTS};
 use crate::skeleton::hierarchy::infer_hierarchy;
-use crate::skeleton::placement::{check_placement, decomposition_warnings, listed, PlacementError};
+use crate::skeleton::placement::{check_placement, decomposition_warnings, PlacementError};
 use crate::weights::blend::Blend;
-use crate::weights::twins::LARGEST_CLASS;
+use crate::weights::rigid::{bind_rigidly, Binding};
 use crate::weights::{compute_weights, SurfaceWeights, WeightCounts, WeightsError};
 use atlas_skin_runtime::{RuntimeError, Skeleton, VertexWeights};
 use glam::{DVec3, Vec3};
@@ -71,8 +72,13 @@ pub struct SkinParams {
     pub overlap: OverlapParams,
     /// §4: how overlapping regions are blended.
     pub blend: Blend,
+    /// Blended weights, or one joint per vertex ([`crate::weights::rigid`]).
+    pub binding: Binding,
     /// Influences kept per stored vertex, the largest, renormalised (at least 1).
     pub max_influences: usize,
+    /// §4–5: rules of the weights stage switched off, to measure each alone (a developer
+    /// setting: [`crate::ablation`]).
+    pub weights_rules_off: RulesOff,
 }
 
 impl Default for SkinParams {
@@ -81,7 +87,9 @@ impl Default for SkinParams {
             decompose: DecomposeParams::default(),
             overlap: OverlapParams::default(),
             blend: Blend::default(),
+            binding: Binding::default(),
             max_influences: 4,
+            weights_rules_off: RulesOff::default(),
         }
     }
 }
@@ -156,8 +164,11 @@ pub struct Skinned {
     pub welded_of_stored: Vec<u32>,
     pub decomposition: Decomposition,
     pub overlaps: Overlaps,
-    /// Weights of every split-surface vertex, before pruning.
+    /// Weights of every split-surface vertex, before pruning (one joint each when bound
+    /// rigidly).
     pub surface_weights: SurfaceWeights,
+    /// How the vertices were bound (the settings' [`Binding`]).
+    pub binding: Binding,
     /// Weights of every stored vertex: at most `max_influences`, summing to 1.
     pub weights: VertexWeights,
     pub timings: StageTimings,
@@ -252,28 +263,15 @@ pub fn skin(
     done(&mut timings);
 
     let done = run(Stage::Weights);
-    let (surface_weights, weight_counts) =
-        compute_weights(&decomposition, &skeleton, &overlaps, params.blend)?;
-    if !weight_counts.twins_given_a_share.is_empty() {
-        warnings.push(format!(
-            "{} joint(s) sit at the point of a joint that has weight and got none of their \
-             own: each shares its twins' weight equally (nothing in the geometry tells them \
-             apart): {}",
-            weight_counts.twins_given_a_share.len(),
-            listed(
-                weight_counts
-                    .twins_given_a_share
-                    .iter()
-                    .map(|&j| skeleton.names[j as usize].clone())
-            )
-        ));
-    }
-    if weight_counts.twins_too_many_to_share > 0 {
-        warnings.push(format!(
-            "{} joints sit at one point in classes of more than {LARGEST_CLASS}: their \
-             weight is not shared among them, each keeps what the rules gave it",
-            weight_counts.twins_too_many_to_share
-        ));
+    let (mut surface_weights, weight_counts) = compute_weights(
+        &decomposition,
+        &skeleton,
+        &overlaps,
+        params.blend,
+        &params.weights_rules_off,
+    )?;
+    if params.binding == Binding::Rigid {
+        surface_weights = bind_rigidly(&surface_weights, &skeleton);
     }
     let weights = unweld_weights(
         &surface_weights,
@@ -302,6 +300,7 @@ pub fn skin(
         decomposition,
         overlaps,
         surface_weights,
+        binding: params.binding,
         weights,
         timings,
         counts,

@@ -15,10 +15,6 @@ pub struct DecompositionReport {
     /// Regions the child sides of unrelated joints' cuts shared, divided among them.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub shared_sides: Vec<SharedSideReport>,
-    /// The local axis of the bind frames that runs along the bones (`+y` for Blender's
-    /// rigs), which gave the joints without child bones their direction; `None` (null)
-    /// when the frames have none.
-    pub bone_axis: Option<String>,
 }
 
 /// A divided region: the head joint of each family of cuts that shared it and the region
@@ -118,7 +114,6 @@ impl Decomposition {
                     regions: shared.regions.clone(),
                 })
                 .collect(),
-            bone_axis: self.bone_axis.map(|axis| axis.name()),
         }
     }
 }

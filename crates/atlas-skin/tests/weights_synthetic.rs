@@ -177,7 +177,6 @@ fn decompose_by_hand(
         boundaries,
         joints,
         shared_sides: Vec::new(),
-        bone_axis: None,
         surface_spheres: Default::default(),
     }
 }
@@ -185,8 +184,14 @@ fn decompose_by_hand(
 fn weights_of(decomposition: &Decomposition, skeleton: &Skeleton, blend: Blend) -> SurfaceWeights {
     let overlaps =
         compute_overlaps(decomposition, skeleton, &OverlapParams::default()).expect("overlaps");
-    let (weights, counts) =
-        compute_weights(decomposition, skeleton, &overlaps, blend).expect("weights");
+    let (weights, counts) = compute_weights(
+        decomposition,
+        skeleton,
+        &overlaps,
+        blend,
+        &Default::default(),
+    )
+    .expect("weights");
     assert_eq!(counts.unreachable, 0);
     weights
 }
@@ -196,9 +201,15 @@ fn weights_of(decomposition: &Decomposition, skeleton: &Skeleton, blend: Blend) 
 fn region_weights_of(decomposition: &Decomposition, skeleton: &Skeleton) -> SurfaceWeights {
     let overlaps =
         compute_overlaps(decomposition, skeleton, &OverlapParams::default()).expect("overlaps");
-    region_weights(decomposition, skeleton, &overlaps, Blend::PartitionOfUnity)
-        .expect("weights")
-        .weights
+    region_weights(
+        decomposition,
+        skeleton,
+        &overlaps,
+        Blend::PartitionOfUnity,
+        &Default::default(),
+    )
+    .expect("weights")
+    .weights
 }
 
 fn weight(weights: &SurfaceWeights, v: usize, joint: u32) -> f64 {
@@ -562,6 +573,7 @@ fn a_gap_of_a_decomposed_piece_is_weighted_as_a_whole() {
         &skeleton,
         &overlaps,
         Blend::PartitionOfUnity,
+        &Default::default(),
     )
     .expect("weights");
     assert_partition_of_unity(&weights);
@@ -661,74 +673,6 @@ fn tube_region(skeleton: &Skeleton, softs: &[(Plane, f64)]) -> (SurfaceMesh, Dec
         decision.region = Some(0);
     }
     (mesh, decomposition)
-}
-
-/// Three short leaf bones lying just under the top of the tube (heads at y = 0.8, tails
-/// on the skin at y = 1, half a unit apart), like the lip bones of a face rig, on a chain
-/// along the tube's axis; `tails` says whether the file gives their tails.
-fn skin_leaves(tails: bool) -> Skeleton {
-    let xs = [5.5f32, 6.0, 6.5];
-    let mut positions = vec![Vec3::new(0.5, 0.0, 0.0), Vec3::new(11.5, 0.0, 0.0)];
-    positions.extend(xs.map(|x| Vec3::new(x, 0.8, 0.0)));
-    let names = ["root", "end", "leaf_a", "leaf_b", "leaf_c"].map(String::from);
-    let skeleton =
-        Skeleton::from_positions(names.to_vec(), vec![NO_PARENT, 0, 0, 0, 0], &positions)
-            .expect("skeleton");
-    let mut leaf_tails = vec![None, None];
-    leaf_tails.extend(xs.map(|x| tails.then_some(Vec3::new(x, 1.0, 0.0))));
-    skeleton.with_tails(leaf_tails).expect("tails")
-}
-
-#[test]
-fn leaf_bones_with_tails_move_the_skin_around_their_tails() {
-    let skeleton = skin_leaves(true);
-    let (mesh, decomposition) = tube_region(&skeleton, &[]);
-    let weights = weights_of(&decomposition, &skeleton, Blend::PartitionOfUnity);
-    assert_partition_of_unity(&weights);
-    let at_tail = nearest_vertex(&mesh, DVec3::new(6.0, 1.0, 0.0));
-    assert!(
-        weight(&weights, at_tail, 3) > 0.5,
-        "{:?}",
-        weights.row(at_tail).collect::<Vec<_>>()
-    );
-    // The patches stay within their radius (3 × the 0.5 spacing of the tails) of the tails:
-    // the far side of the tube and its ends move with the chain alone.
-    for (v, p) in mesh.positions.iter().enumerate() {
-        if p.y < -0.5 || (p.x - 6.0).abs() > 3.0 {
-            for leaf in 2..5 {
-                assert_eq!(weight(&weights, v, leaf), 0.0, "leaf {leaf} at {p}");
-            }
-        }
-    }
-    for v in 0..mesh.vertex_count() {
-        for &u in decomposition.topology.neighbors(v) {
-            for leaf in 2..5 {
-                let step = (weight(&weights, v, leaf) - weight(&weights, u as usize, leaf)).abs();
-                assert!(
-                    step < 0.3,
-                    "leaf {leaf}'s weight jumps by {step} from {v} to {u}"
-                );
-            }
-        }
-    }
-}
-
-#[test]
-fn leaf_bones_without_tails_or_skin_of_their_own_move_nothing() {
-    let untailed = skin_leaves(false);
-    let (mesh, decomposition) = tube_region(&untailed, &[]);
-    let weights = weights_of(&decomposition, &untailed, Blend::PartitionOfUnity);
-    let tailed = skin_leaves(true);
-    let (_, mut excluded) = tube_region(&tailed, &[]);
-    excluded.joints[3].owns_skin = false;
-    let without_b = weights_of(&excluded, &tailed, Blend::PartitionOfUnity);
-    assert_partition_of_unity(&without_b);
-    for v in 0..mesh.vertex_count() {
-        assert_eq!(weights.row(v).collect::<Vec<_>>(), vec![(0, 1.0)]);
-        assert_eq!(weight(&without_b, v, 3), 0.0);
-    }
-    let at_tail = nearest_vertex(&mesh, DVec3::new(6.0, 1.0, 0.0));
-    assert!(weight(&without_b, at_tail, 2) > 0.0);
 }
 
 #[test]

@@ -206,6 +206,12 @@ fn summary(e: &Evaluation) -> String {
             e.weights_l1.max,
             100.0 * e.weights_l1.dominant_agreement
         ),
+        e.rignet.map_or_else(String::new, |r| {
+            format!(
+                "{:<22} precision {:.3}  recall {:.3}  L1 {:.3}  (RigNet's, over {} vertices)\n",
+                "influences", r.precision, r.recall, r.l1, r.vertices
+            )
+        }),
         deform("deform, random (LBS)", Some(&e.deform_random)),
         deform("deform, random (DQS)", Some(&e.deform_random_dqs)),
         deform("deform, animation", e.deform_anim.as_ref()),

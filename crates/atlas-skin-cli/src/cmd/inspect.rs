@@ -4,10 +4,8 @@
 use crate::input::{InputArgs, Prepared};
 use anyhow::Result;
 use atlas_skin::mesh::winding::is_inside;
-use atlas_skin::skeleton::bone_axis::infer_bone_axis;
 use atlas_skin_io::gltf::{Binding, PrimitiveSource};
 use atlas_skin_io::PartBinding;
-use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::BTreeSet;
@@ -61,10 +59,6 @@ pub struct Report {
     pub nonmanifold_edges: usize,
     pub inconsistently_oriented_edges: usize,
     pub joints: Vec<JointReport>,
-    /// The local axis of the joints' bind frames that runs along their bones (`+y` for
-    /// Blender's rigs), from which leaf joints take their direction; null when the frames
-    /// have none or there is no skeleton.
-    pub bone_axis: Option<String>,
     /// For glTF input with a skin: the meshes read.
     pub gltf_meshes: Option<GltfMeshes>,
     /// Whether the input came with weights (artist or precomputed).
@@ -158,14 +152,6 @@ impl Report {
             }
             None => Vec::new(),
         };
-        let bone_axis = character.skeleton.as_ref().and_then(|skeleton| {
-            let positions: Vec<DVec3> = skeleton
-                .bind_positions()
-                .iter()
-                .map(|p| p.as_dvec3())
-                .collect();
-            infer_bone_axis(skeleton, &positions, &skeleton.children()).map(|a| a.name())
-        });
         Self {
             input: character.path.display().to_string(),
             space: character.space.clone(),
@@ -203,7 +189,6 @@ impl Report {
             nonmanifold_edges: stats.nonmanifold_edges,
             inconsistently_oriented_edges: stats.inconsistently_oriented_edges,
             joints,
-            bone_axis,
             gltf_meshes: character.gltf.as_ref().and_then(GltfMeshes::of),
             reference_weights: character.reference_weights.is_some(),
             clips: character
@@ -292,15 +277,6 @@ impl Report {
                 "  {flag} {indent}{deep}{} ({x:.4}, {y:.4}, {z:.4})",
                 joint.name
             ));
-        }
-        if !self.joints.is_empty() {
-            lines.push(match &self.bone_axis {
-                Some(axis) => format!(
-                    "bone axis:             {axis} of the bind frames (leaf joints point along it)"
-                ),
-                None => "bone axis:             none (leaf joints continue their parents' bones)"
-                    .to_string(),
-            });
         }
         lines.push(format!(
             "reference weights:     {}",

@@ -6,6 +6,7 @@
 use crate::input::InputArgs;
 use anyhow::{bail, Context, Result};
 use atlas_skin::weights::blend::Blend;
+use atlas_skin::weights::rigid::Binding;
 use atlas_skin_job::{Outputs, Settings, SkinJob};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -42,7 +43,7 @@ pub struct Args {
 #[derive(clap::Args)]
 pub struct MethodArgs {
     /// Settings as JSON (any subset of `decompose`, `overlap` {`factor`, `per_joint`},
-    /// `blend`, `max_influences`); the options below override it.
+    /// `blend`, `binding`, `max_influences`); the options below override it.
     #[arg(long, value_name = "FILE.json")]
     pub config: Option<PathBuf>,
     /// Overlap half-width as a multiple of each boundary's diameter (the paper: 0.5).
@@ -55,6 +56,11 @@ pub struct MethodArgs {
     /// or the paper's Eq. 1.
     #[arg(long, value_enum)]
     pub blend: Option<BlendArg>,
+    /// Blended weights (default), or one joint per vertex for a character its artist would
+    /// bind rigidly: the same cuts, each vertex moving with the deepest joint whose branch
+    /// holds more than half of its blended weights.
+    #[arg(long, value_enum)]
+    pub binding: Option<BindingArg>,
     /// Give this joint a boundary even where the rules would not, also one named as a
     /// helper that otherwise moves no skin (repeatable).
     #[arg(long, value_name = "JOINT")]
@@ -86,6 +92,24 @@ impl From<BlendArg> for Blend {
     }
 }
 
+/// `--binding` values.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub enum BindingArg {
+    /// Blended weights: a vertex may follow several joints.
+    Smooth,
+    /// One joint per vertex, with weight 1.
+    Rigid,
+}
+
+impl From<BindingArg> for Binding {
+    fn from(arg: BindingArg) -> Self {
+        match arg {
+            BindingArg::Smooth => Binding::Smooth,
+            BindingArg::Rigid => Binding::Rigid,
+        }
+    }
+}
+
 impl MethodArgs {
     /// The job's settings; `--overlap-joint` entries parsed.
     pub fn settings(&self) -> Result<Settings> {
@@ -104,6 +128,7 @@ impl MethodArgs {
             overlap: self.overlap,
             overlap_joints,
             blend: self.blend.map(Blend::from),
+            binding: self.binding.map(Binding::from),
             force: self.force.clone(),
             forbid: self.forbid.clone(),
             max_influences: self.max_influences,

@@ -27,6 +27,10 @@ class MethodOptions(TypedDict, total=False):
       (``--overlap-joint NAME=F``).
     - ``blend``: ``"pou"`` (default: the normalised partition of unity, continuous
       everywhere) or ``"paper"`` (the paper's Eq. 1) (``--blend``).
+    - ``binding``: ``"smooth"`` (default: blended weights) or ``"rigid"`` (one joint per
+      vertex, weight 1, for a character its artist would bind rigidly: the same cuts, each
+      vertex moving with the deepest joint whose branch holds more than half of its blended
+      weights) (``--binding``).
     - ``force``: joint names given a boundary (a cut) even where the rules would not
       (``--force``).
     - ``forbid``: joint names given no boundary: their part moves with the parent's
@@ -34,13 +38,14 @@ class MethodOptions(TypedDict, total=False):
     - ``max_influences``: influences kept per vertex, the largest, renormalised (1..=32,
       default 4) (``--max-influences``).
     - ``config``: a settings file (``--config``: JSON, any subset of ``decompose``,
-      ``overlap`` {``factor``, ``per_joint``}, ``blend``, ``max_influences``), which the
-      options above override.
+      ``overlap`` {``factor``, ``per_joint``}, ``blend``, ``binding``, ``max_influences``),
+      which the options above override.
     """
 
     overlap: Optional[float]
     overlap_joints: Optional[Mapping[str, float]]
     blend: Optional[str]
+    binding: Optional[str]
     force: Optional[Sequence[str]]
     forbid: Optional[Sequence[str]]
     max_influences: Optional[int]
@@ -76,15 +81,14 @@ def compute_weights(
       joint to its tail (without one, it continues the parent's bone by half its length).
     - ``inverse_bind``: ``(J, 4, 4)`` floats, the inverse of each joint's bind frame
       (``M[row, column]`` acting on column vectors, as ``load`` returns them); their
-      translations must place the joints at ``joint_positions``. When the frames run along
-      the bones (a Blender or Maya rig), a leaf joint takes its direction from its frame
-      (the report's ``decomposition.bone_axis``); without them every frame is the world's.
+      translations must place the joints at ``joint_positions``. The weights do not depend
+      on the frames' rotations; without them every frame is the world's.
     - ``names``: ``J`` unique joint names (default ``joint0``, ``joint1``, ...): the names
       that ``overlap_joints``, ``force`` and ``forbid`` use, and that the report shows.
     - ``end_joints``: joints that move nothing (the leaves of a TGF skeleton, libigl's
       handles): given no boundary unless forced.
     - ``**options``: the method's options (``MethodOptions``: ``overlap``,
-      ``overlap_joints``, ``blend``, ``force``, ``forbid``, ``max_influences``,
+      ``overlap_joints``, ``blend``, ``binding``, ``force``, ``forbid``, ``max_influences``,
       ``config``).
 
     Returns ``(indices, weights, report)``: ``(V, K)`` uint32 joint indices and ``(V, K)``

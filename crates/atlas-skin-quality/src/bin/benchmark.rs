@@ -7,9 +7,13 @@
 //! against an earlier run. Run it through `scripts/benchmark`.
 
 use anyhow::{bail, Context, Result};
-use atlas_skin_quality::bench_characters::{bench_characters, model_characters, Set};
+use atlas_skin_quality::bench_characters::{
+    bench_characters, large_characters, model_characters, Group, Set,
+};
 use atlas_skin_quality::bench_run::{run_all, BenchmarkRun, Outcome, Settings, OTHER_SEEDS};
-use atlas_skin_quality::{baselines, bench_baselines, bench_compare, bench_page, run};
+use atlas_skin_quality::{
+    baselines, bench_baselines, bench_compare, bench_page, group_scores, run,
+};
 use clap::{Parser, ValueEnum};
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -19,8 +23,12 @@ const WORKSPACE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum SetArg {
-    /// ../shared/data/bench: 65 game characters, against bench/BASELINES.md.
+    /// ../shared/data/bench: 65 game characters, against bench/BASELINES.md (tune).
     Bench,
+    /// ../shared/data/bench-large/rignet-train: 400 characters to tune on.
+    Train,
+    /// ../shared/data/bench-large/rignet-check: 210 characters to confirm on.
+    Check,
     /// ../shared/data/models: the clean corpus, against BASELINES.md.
     Models,
 }
@@ -87,6 +95,11 @@ fn main() -> Result<()> {
     let mut characters = Vec::new();
     if wanted(SetArg::Bench) {
         characters.extend(bench_characters(&args.data.join("bench"))?);
+    }
+    for (arg, set) in [(SetArg::Train, Set::Train), (SetArg::Check, Set::Check)] {
+        if wanted(arg) {
+            characters.extend(large_characters(&args.data, set)?);
+        }
     }
     if wanted(SetArg::Models) {
         characters.extend(model_characters(&args.data.join("models")));
@@ -163,6 +176,22 @@ fn main() -> Result<()> {
         "{}",
         bench_page::render(&run, &bench_table, &models_table, false)
     );
+    let groups_now: Vec<_> = Group::ALL
+        .iter()
+        .filter_map(|&g| group_scores::group_scores(&run, g))
+        .collect();
+    for g in &groups_now {
+        println!("{}", group_scores::summary_line(g));
+    }
+    if let Some(old) = &old {
+        println!("before ({}):", old.commit);
+        for g in Group::ALL
+            .iter()
+            .filter_map(|&g| group_scores::group_scores(old, g))
+        {
+            println!("{}", group_scores::summary_line(&g));
+        }
+    }
     if let (Some(old), Some(path)) = (&old, &args.compare) {
         println!(
             "{}",

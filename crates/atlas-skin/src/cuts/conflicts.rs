@@ -8,12 +8,7 @@
 //! in increasing order of their best perimeter, so the small cross-sections of fingers,
 //! toes and distal limbs are placed before the palm, leg-root, neck and torso planes that
 //! would cross them; branching joints on the mirror plane (a spine joint where the legs or
-//! the arms branch) come after all others, whatever their perimeter. Last come the joints
-//! whose best section is more than [`WIDE_SECTION_RATIO`] times as long as their parent's
-//! best section: a limb narrows or keeps its width from joint to joint, so a section that
-//! much wider than the one before it is not the limb's but a plane through a larger body
-//! beside it (the clavicle of a biped rig, a child of the neck, whose plane slices the side
-//! of the chest); such a cut yields to the joints it would block. A joint whose best
+//! the arms branch) come after all others, whatever their perimeter. A joint whose best
 //! curve conflicts with an already placed one tries its next-best closed sections (the
 //! other sampled planes, by increasing perimeter); when none fits, it gets a soft boundary:
 //! its plane restricted to the region that holds it (METHOD.md, "extensions"), which the
@@ -31,14 +26,10 @@
 use super::joint_roles::{JointFrame, JointPlan};
 use super::plane_search::{CutCandidate, CutSearch};
 use super::plane_section::{Chord, CrossingPoint, SectionCurve};
+use crate::ablation::{Rule, RulesOff};
 use crate::mesh::{SurfaceMesh, Topology};
-use atlas_skin_runtime::{Skeleton, NO_PARENT};
+use atlas_skin_runtime::Skeleton;
 use std::collections::HashMap;
-
-/// A joint's best section longer than this many times its parent's best section is placed
-/// last (module documentation). Measured on the benchmark: any ratio from 2 to 4 gives the
-/// same placements (docs/measurements.md, "Sections wider than the parent's").
-pub const WIDE_SECTION_RATIO: f64 = 3.0;
 
 /// What the search of one joint found among the placed cuts.
 #[derive(Debug, Clone, PartialEq)]
@@ -74,16 +65,18 @@ pub fn place_cuts(
     plans: &[JointPlan],
     searches: &[CutSearch],
     gap: f64,
+    rules_off: &RulesOff,
 ) -> Vec<Placement> {
     let candidates: Vec<&[CutCandidate]> = searches.iter().map(|s| &s.candidates[..]).collect();
-    let order = placement_order(plans, &candidates, &skeleton.parents);
+    let order = placement_order(plans, &candidates);
+    let twins_alike = rules_off.on(Rule::MirrorTwins);
     // Joints denied a cut because their mirror twin gets none. The set only grows, so the
     // passes end; each pass places the others again without the denied joints' cuts.
     let mut denied: Vec<Option<u32>> = vec![None; plans.len()];
     let placed = loop {
         let placed = place_in_order(mesh, topology, &order, &candidates, &denied, gap);
         let mut grew = false;
-        for (j, plan) in plans.iter().enumerate() {
+        for (j, plan) in plans.iter().enumerate().filter(|_| twins_alike) {
             let Some(twin) = mirror_twin(plan) else {
                 continue;
             };
@@ -192,37 +185,19 @@ impl Board {
 /// The joint's mirror twin, when its plan searches a cut.
 fn mirror_twin(plan: &JointPlan) -> Option<u32> {
     match plan {
-        JointPlan::Boundary(frame) | JointPlan::CutOrSkip(frame, _) => frame.mirror_twin,
+        JointPlan::Boundary(frame) => frame.mirror_twin,
         _ => None,
     }
 }
 
 /// The joints that search a cut, in the order of the module documentation: by increasing
-/// best perimeter, branching joints on the mirror plane after the others, joints whose best
-/// section is wider than [`WIDE_SECTION_RATIO`] times their parent's last. `parents` are the
-/// skeleton's ([`NO_PARENT`] for a root).
-fn placement_order(
-    plans: &[JointPlan],
-    candidates: &[&[CutCandidate]],
-    parents: &[u32],
-) -> Vec<usize> {
-    let best_perimeter = |j: usize| candidates[j].first().map(|c| c.perimeter);
+/// best perimeter, branching joints on the mirror plane after the others.
+fn placement_order(plans: &[JointPlan], candidates: &[&[CutCandidate]]) -> Vec<usize> {
     let group = |j: usize| {
-        let wider_than_parent = parents[j] != NO_PARENT
-            && best_perimeter(parents[j] as usize)
-                .zip(best_perimeter(j))
-                .is_some_and(|(parent, own)| own > WIDE_SECTION_RATIO * parent);
-        if wider_than_parent {
-            2
-        } else {
-            u8::from(matches!(&plans[j], JointPlan::Boundary(frame) if frame.on_mirror_plane))
-        }
+        u8::from(matches!(&plans[j], JointPlan::Boundary(frame) if frame.on_mirror_plane))
     };
     let mut order: Vec<usize> = (0..plans.len())
-        .filter(|&j| {
-            matches!(plans[j], JointPlan::Boundary(_) | JointPlan::CutOrSkip(..))
-                && !candidates[j].is_empty()
-        })
+        .filter(|&j| matches!(plans[j], JointPlan::Boundary(_)) && !candidates[j].is_empty())
         .collect();
     order.sort_by(|&a, &b| {
         group(a).cmp(&group(b)).then(
@@ -250,19 +225,6 @@ fn placement_of(
             return Placement::Soft {
                 reason: reason.clone(),
                 frame: *frame,
-            }
-        }
-        JointPlan::CutOrSkip(frame, reason) => {
-            return match placed {
-                Some(Search::Accepted(candidate)) => Placement::Cut {
-                    candidate,
-                    frame: *frame,
-                },
-                Some(Search::TwinWithoutCut(twin)) => Placement::Skip(format!(
-                    "{reason}; its mirror twin {} gets no cut",
-                    skeleton.names[twin as usize]
-                )),
-                _ => Placement::Skip(reason.clone()),
             }
         }
         JointPlan::Boundary(frame) => *frame,
@@ -323,80 +285,20 @@ fn curve_vertices(curve: &SectionCurve) -> Vec<u32> {
 mod tests {
     use super::*;
     use crate::cuts::plane_section::{closed_length, Plane};
+    use atlas_skin_runtime::NO_PARENT;
     use glam::DVec3;
 
-    fn boundary(on_mirror_plane: bool) -> JointPlan {
+    fn boundary() -> JointPlan {
         JointPlan::Boundary(JointFrame {
             position: DVec3::ZERO,
             upper: DVec3::Y,
             lower: DVec3::Y,
             bone_length: 1.0,
             surface_distance: 0.1,
-            on_mirror_plane,
+            on_mirror_plane: false,
             mirror_twin: None,
             leaf_part_past: false,
         })
-    }
-
-    /// A candidate of this perimeter (the order reads nothing else).
-    fn candidate(perimeter: f64) -> CutCandidate {
-        CutCandidate {
-            plane: Plane {
-                point: DVec3::ZERO,
-                normal: DVec3::Y,
-            },
-            curve: SectionCurve {
-                crossings: Vec::new(),
-                faces: Vec::new(),
-            },
-            points: Vec::new(),
-            perimeter,
-        }
-    }
-
-    /// The order of the joints of a root → chest (on the mirror plane) → neck → clavicle →
-    /// upper arm chain whose best sections have these perimeters.
-    fn order_of_chain(perimeters: [f64; 4]) -> Vec<usize> {
-        let parents = [NO_PARENT, 0, 1, 2, 3];
-        let plans = [
-            JointPlan::Skip("root".into()),
-            boundary(true),
-            boundary(false),
-            boundary(false),
-            boundary(false),
-        ];
-        let candidates: Vec<Vec<CutCandidate>> = std::iter::once(Vec::new())
-            .chain(perimeters.iter().map(|&p| vec![candidate(p)]))
-            .collect();
-        let candidates: Vec<&[CutCandidate]> = candidates.iter().map(|c| &c[..]).collect();
-        placement_order(&plans, &candidates, &parents)
-    }
-
-    #[test]
-    fn a_leaf_that_owns_its_part_only_with_a_cut_is_skipped_without_one() {
-        let skeleton = Skeleton::from_positions(
-            vec!["leg".into(), "ankle".into()],
-            vec![NO_PARENT, 0],
-            &[glam::Vec3::Y, glam::Vec3::ZERO],
-        )
-        .expect("valid skeleton");
-        let JointPlan::Boundary(frame) = boundary(false) else {
-            unreachable!()
-        };
-        let plan = JointPlan::CutOrSkip(frame, "end site".into());
-        let search = CutSearch::default();
-        let blocked = placement_of(&plan, Some(Search::Blocked(vec![0])), &search, &skeleton);
-        assert_eq!(blocked, Placement::Skip("end site".into()));
-        let none = placement_of(&plan, None, &search, &skeleton);
-        assert_eq!(none, Placement::Skip("end site".into()));
-        let placed = placement_of(&plan, Some(Search::Accepted(2)), &search, &skeleton);
-        assert_eq!(
-            placed,
-            Placement::Cut {
-                candidate: 2,
-                frame
-            }
-        );
     }
 
     /// Mirror twins (joints 1 and 2 of a tube along +Y) whose only sections cross each
@@ -453,7 +355,7 @@ mod tests {
         )
         .expect("valid skeleton");
         let twin_of = |twin: u32| {
-            let JointPlan::Boundary(frame) = boundary(false) else {
+            let JointPlan::Boundary(frame) = boundary() else {
                 unreachable!()
             };
             JointPlan::Boundary(JointFrame {
@@ -463,7 +365,15 @@ mod tests {
             })
         };
         let plans = [JointPlan::Skip("root".into()), twin_of(2), twin_of(1)];
-        place_cuts(&mesh, &topology, &skeleton, &plans, &searches, 0.01)
+        place_cuts(
+            &mesh,
+            &topology,
+            &skeleton,
+            &plans,
+            &searches,
+            0.01,
+            &RulesOff::default(),
+        )
     }
 
     #[test]
@@ -489,13 +399,5 @@ mod tests {
         assert!(strangers[1..]
             .iter()
             .any(|p| matches!(p, Placement::Soft { reason, .. } if reason.contains("crosses"))));
-    }
-
-    #[test]
-    fn a_section_much_wider_than_its_parents_is_placed_last() {
-        // The clavicle's section 4 times the neck's: a plane through the side of the chest.
-        assert_eq!(order_of_chain([1.0, 0.3, 1.2, 0.5]), [2, 4, 1, 3]);
-        // 2.5 times the neck's: a limb's, placed by perimeter before the chest.
-        assert_eq!(order_of_chain([1.0, 0.3, 0.75, 0.5]), [2, 4, 3, 1]);
     }
 }

@@ -1,6 +1,7 @@
 //! Settings of the decomposition (§3.1 plane search, joint roles, conflicts; §3.2 has
 //! none), their validation, and the per-joint overrides: the user's, and helper names.
 
+use crate::ablation::{Rule, RulesOff};
 use crate::skeleton::helpers::helper_joints;
 use atlas_skin_runtime::{RuntimeError, Skeleton};
 use serde::{Deserialize, Serialize};
@@ -35,6 +36,9 @@ pub struct DecomposeParams {
     pub force: Vec<String>,
     /// Joints (by name) that get no boundary.
     pub forbid: Vec<String>,
+    /// Rules of this stage switched off, to measure each alone (a developer setting:
+    /// [`crate::ablation`]).
+    pub rules_off: RulesOff,
 }
 
 impl Default for DecomposeParams {
@@ -50,6 +54,7 @@ impl Default for DecomposeParams {
             symmetry_tolerance: 0.02,
             force: Vec::new(),
             forbid: Vec::new(),
+            rules_off: RulesOff::default(),
         }
     }
 }
@@ -180,8 +185,9 @@ impl DecomposeParams {
                 overrides[j] = Some(value);
             }
         }
+        let helpers_by_name = self.rules_off.on(Rule::HelperNames);
         for (o, helper) in overrides.iter_mut().zip(helper_joints(skeleton)) {
-            if helper && o.is_none() {
+            if helpers_by_name && helper && o.is_none() {
                 *o = Some(Override::Helper);
             }
         }

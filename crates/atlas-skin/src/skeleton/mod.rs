@@ -1,13 +1,11 @@
 //! What the method reads from the skeleton beyond the runtime's [`Skeleton`]
-//! (`atlas_skin_runtime`): the bone axis of its bind frames, which gives leaves their
-//! direction ([`bone_axis`]), bone segments and nearest bones ([`bones`], [`bone_tree`]), a hierarchy for
+//! (`atlas_skin_runtime`): bone segments and nearest bones ([`bones`], [`bone_tree`]), a hierarchy for
 //! skeletons with several roots ([`hierarchy`]), joints named as helpers that deform nothing
 //! ([`helpers`]), the nearest joint ([`nearest_point`]), whether the skeleton sits in the mesh
 //! ([`placement`]).
 //!
 //! [`Skeleton`]: atlas_skin_runtime::Skeleton
 
-pub mod bone_axis;
 pub mod bone_tree;
 pub mod bones;
 pub mod helpers;

@@ -1,9 +1,8 @@
-//! Steps 2, 3 and 3b of the weights for every vertex: the related regions blended (§4),
-//! each region's weight shared along the chain of its joints (soft boundaries) and with its
-//! leaf patches (module documentation of [`crate::weights`]).
+//! Steps 2 and 3 of the weights for every vertex: the related regions blended (§4), each
+//! region's weight shared along the chain of its joints (soft boundaries) (module
+//! documentation of [`crate::weights`]).
 
 use super::blend::{blend_regions, Blend};
-use super::patches::Patch;
 use super::soft_sides::SoftSide;
 use super::surface_weights::SurfaceWeights;
 use crate::decomposition::Decomposition;
@@ -88,17 +87,6 @@ pub fn region_trees(
         .collect()
 }
 
-/// Per vertex, the (patch, p_j) of every leaf patch holding it.
-fn patch_shares(patches: &[Patch], vertex_count: usize) -> Rows<(u32, f64)> {
-    let entries = patches.iter().enumerate().flat_map(|(k, patch)| {
-        patch
-            .shares
-            .iter()
-            .map(move |&(v, share)| (v as usize, (k as u32, share)))
-    });
-    Rows::group(vertex_count, entries)
-}
-
 /// Per vertex, the (soft side, κ_c, π_c) of every soft side reaching it.
 fn soft_reaches(softs: &[SoftSide], vertex_count: usize) -> Rows<(u32, f64, f64)> {
     let entries = softs.iter().enumerate().flat_map(|(s, soft)| {
@@ -126,11 +114,9 @@ pub fn blend_vertices(
     decomposition: &Decomposition,
     related: &Rows<(u32, f64)>,
     softs: &[SoftSide],
-    patches: &[Patch],
     trees: &[RegionTree],
     blend: Blend,
 ) -> SurfaceWeights {
-    let patch_shares = patch_shares(patches, decomposition.surface.vertex_count());
     let soft_reaches = soft_reaches(softs, decomposition.surface.vertex_count());
     // The node of every soft side in its region's tree.
     let mut node_of_soft = vec![None; softs.len()];
@@ -167,21 +153,10 @@ pub fn blend_vertices(
                 scratch.shares.sort_unstable_by_key(|&(node, _)| node);
                 let mass = &mut scratch.mass;
                 share_along_chain(tree, &scratch.shares, omega, mass, &mut scratch.parents);
-                // Step 3b: the leaf patches take their shares of every joint's mass alike.
-                let in_region = patch_shares
-                    .row(v)
-                    .iter()
-                    .filter(move |&&(k, _)| patches[k as usize].region == r);
-                let patch_total: f64 = in_region.clone().map(|&(_, p)| p).sum();
-                let keep = 1.0 - patch_total.min(1.0);
-                let patch_masses = in_region
-                    .map(|&(k, p)| (patches[k as usize].joint, omega * p / patch_total.max(1.0)));
                 // The nodes with mass: the root and those with shares, in node order.
                 let nodes = std::iter::once(0).chain(scratch.shares.iter().map(|&(c, _)| c));
-                let joint_masses: Vec<(u32, f64)> = nodes
-                    .map(|c| (tree.joints[c], std::mem::take(&mut mass[c]) * keep))
-                    .collect();
-                for (joint, m) in joint_masses.into_iter().chain(patch_masses) {
+                for c in nodes {
+                    let (joint, m) = (tree.joints[c], std::mem::take(&mut mass[c]));
                     if m <= 0.0 {
                         continue;
                     }

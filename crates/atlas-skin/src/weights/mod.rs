@@ -53,13 +53,7 @@
 //!    region's edge). A soft boundary with no cross-section near its joint is inactive
 //!    (see `soft_sides`).
 //!
-//!    **3b. Leaf patches.** A leaf bone with a stated tail and no active boundary (a face
-//!    bone lying in the skin) takes a share p_j of the region's weight at every vertex of
-//!    its patch ([`crate::weights::patches`]): with P = Σ_j p_j over the region's patches, every
-//!    joint of the region keeps its mass times 1 − min(1, P), and patch j receives
-//!    ω p_j / max(1, P).
-//!
-//!    **3c. Sibling blends.** Where two joints of which neither is an ancestor of the other
+//!    **3b. Sibling blends.** Where two joints of which neither is an ancestor of the other
 //!    share a vertex (two thighs at a crotch, a neck and a clavicle), part of their common
 //!    weight goes to their lowest common ancestor when its bones are about as near
 //!    ([`siblings`]).
@@ -75,9 +69,10 @@
 //!    correction, vertex by vertex, would tear a piece apart that these rules keep whole
 //!    (a rigid hood whose flared edge lies over the upper arm; docs/measurements.md, "The
 //!    guard against far bones").
-//! 6. **Twins.** Joints at one point that the rules left without any weight, while a
-//!    twin has some, share that twin's weight equally ([`twins`]): nothing in the geometry
-//!    tells them apart, and equal shares are the least wrong whatever the artist chose.
+//!
+//! 7. **Rigid binding.** When the user asks for it ([`rigid::Binding::Rigid`]), each vertex
+//!    then takes one joint with weight 1: the deepest joint whose subtree holds more than
+//!    half of its row ([`rigid`]; the pipeline applies it to the weights of steps 1–6).
 //!
 //! Inputs: a [`Decomposition`], the decomposed skeleton, its [`Overlaps`]
 //! ([`crate::overlap`]) and the [`Blend`]. Output: [`SurfaceWeights`], weights of every
@@ -89,14 +84,14 @@ pub mod carriers;
 pub mod chains;
 pub mod guard;
 pub mod ownership;
-pub mod patches;
 pub mod pieces;
 pub mod related;
+pub mod rigid;
 pub mod siblings;
 pub mod soft_sides;
 pub mod surface_weights;
-pub mod twins;
 
+use crate::ablation::{Rule, RulesOff};
 use crate::decomposition::{BoundaryKind, Decomposition};
 use crate::overlap::Overlaps;
 use crate::skeleton::bones::{bone_segments, JointBones};
@@ -104,13 +99,11 @@ use atlas_skin_runtime::Skeleton;
 use blend::Blend;
 use chains::{blend_vertices, region_trees};
 use guard::guard_far_bones;
-use patches::leaf_patches;
 use pieces::weight_pieces;
-use related::{region_vertices, related_regions, vertex_bands};
+use related::{related_regions, vertex_bands};
 use siblings::merge_sibling_blends;
 use soft_sides::soft_sides;
 use thiserror::Error;
-use twins::share_among_twins;
 
 pub use surface_weights::{SurfaceWeights, WeightCounts};
 
@@ -142,35 +135,40 @@ pub enum WeightsError {
 ///
 /// - `skeleton`: the decomposed skeleton (#J joints, one decision each).
 /// - `overlaps`: from [`crate::overlap::compute_overlaps`] on the same decomposition.
+///
+/// - `rules_off`: rules of this stage switched off ([`crate::ablation`]; none by default).
 pub fn compute_weights(
     decomposition: &Decomposition,
     skeleton: &Skeleton,
     overlaps: &Overlaps,
     blend: Blend,
+    rules_off: &RulesOff,
 ) -> Result<(SurfaceWeights, WeightCounts), WeightsError> {
     let RegionWeights {
         mut weights,
-        leaf_patches,
         inactive_soft_joints,
-    } = region_weights(decomposition, skeleton, overlaps, blend)?;
+    } = region_weights(decomposition, skeleton, overlaps, blend, rules_off)?;
     let owns_skin: Vec<bool> = decomposition.joints.iter().map(|d| d.owns_skin).collect();
     let joint_bones = JointBones::new(&bone_segments(skeleton));
-    let sibling_blend_vertices = merge_sibling_blends(
-        skeleton,
-        &decomposition.surface.positions,
-        &joint_bones,
-        &owns_skin,
-        &leaf_patches,
-        &mut weights,
-    );
-    let far_bone_vertices = guard_far_bones(decomposition, skeleton, &joint_bones, &mut weights);
-    let mut counts = weight_pieces(decomposition, skeleton, overlaps, &mut weights);
-    let twins = share_among_twins(skeleton, &owns_skin, &mut weights);
-    counts.twins_given_a_share = twins.given;
-    counts.twins_too_many_to_share = twins.too_many;
+    let sibling_blend_vertices = if rules_off.on(Rule::SiblingBlends) {
+        merge_sibling_blends(
+            skeleton,
+            &decomposition.surface.positions,
+            &joint_bones,
+            &owns_skin,
+            &mut weights,
+        )
+    } else {
+        0
+    };
+    let far_bone_vertices = if rules_off.on(Rule::FarBoneGuard) {
+        guard_far_bones(decomposition, skeleton, &joint_bones, &mut weights)
+    } else {
+        0
+    };
+    let mut counts = weight_pieces(decomposition, skeleton, overlaps, &mut weights, rules_off);
     counts.far_bone_vertices = far_bone_vertices;
     counts.sibling_blend_vertices = sibling_blend_vertices;
-    counts.leaf_patches = leaf_patches;
     counts.inactive_soft_joints = inactive_soft_joints;
     Ok((weights, counts))
 }
@@ -179,8 +177,6 @@ pub fn compute_weights(
 /// joints reach, the others left without weights.
 pub struct RegionWeights {
     pub weights: SurfaceWeights,
-    /// Leaf joints that move a patch of skin (step 3b).
-    pub leaf_patches: Vec<u32>,
     /// Joints whose soft boundary is inactive (no cross-section near the joint).
     pub inactive_soft_joints: Vec<u32>,
 }
@@ -191,33 +187,21 @@ pub fn region_weights(
     skeleton: &Skeleton,
     overlaps: &Overlaps,
     blend: Blend,
+    rules_off: &RulesOff,
 ) -> Result<RegionWeights, WeightsError> {
     validate(decomposition, skeleton, overlaps)?;
     let vertex_count = decomposition.surface.vertex_count();
     let bands = vertex_bands(&overlaps.bands, vertex_count);
     let related = related_regions(decomposition, overlaps, &bands);
-    let region_vertices = region_vertices(decomposition, &related);
-    let softs = soft_sides(decomposition, skeleton, overlaps, &related);
+    let softs = soft_sides(decomposition, skeleton, overlaps, &related, rules_off);
     let mut has_soft_side = vec![false; skeleton.len()];
     for s in &softs {
         has_soft_side[s.joint as usize] = true;
     }
-    let active: Vec<bool> = decomposition
-        .joints
-        .iter()
-        .enumerate()
-        .map(|(j, decision)| {
-            decision.boundary.is_some_and(|k| {
-                decomposition.boundaries[k as usize].kind != BoundaryKind::Soft || has_soft_side[j]
-            })
-        })
-        .collect();
-    let patches = leaf_patches(decomposition, skeleton, &active, &region_vertices);
     let trees = region_trees(decomposition, skeleton, &softs);
-    let weights = blend_vertices(decomposition, &related, &softs, &patches, &trees, blend);
+    let weights = blend_vertices(decomposition, &related, &softs, &trees, blend);
     Ok(RegionWeights {
         weights,
-        leaf_patches: patches.iter().map(|p| p.joint).collect(),
         inactive_soft_joints: decomposition
             .boundaries
             .iter()

@@ -102,6 +102,7 @@
 use super::carriers::on_one_carrier;
 pub use super::surface_weights::{GapWeighting, PieceTreatment, PieceWeighting};
 use super::surface_weights::{SurfaceWeights, WeightCounts};
+use crate::ablation::{Rule, RulesOff};
 use crate::decomposition::Decomposition;
 use crate::mesh::edge_distance::Nearest;
 use crate::mesh::topology::Topology;
@@ -124,6 +125,7 @@ pub fn weight_pieces(
     skeleton: &Skeleton,
     overlaps: &Overlaps,
     weights: &mut SurfaceWeights,
+    rules_off: &RulesOff,
 ) -> WeightCounts {
     let surface = &decomposition.surface;
     let n = weights.vertex_count();
@@ -197,10 +199,15 @@ pub fn weight_pieces(
                 &unit.faces,
                 &segments,
                 &nearest_joint,
+                rules_off,
             )
         })
         .collect();
-    let held = with_enclosed_joints(decomposition, skeleton, &units, held, &segments);
+    let held = if rules_off.on(Rule::PiecesEnclosedJoints) {
+        with_enclosed_joints(decomposition, skeleton, &units, held, &segments)
+    } else {
+        held.into_iter().map(|h| h.segments).collect()
+    };
     let planes = boundary_planes(decomposition, overlaps);
     // Pieces that hold bones first, on the body surface; then the pieces that hold none,
     // on the body surface and the pieces of the first pass (a hat sits on a head piece).
@@ -230,6 +237,7 @@ pub fn weight_pieces(
             weights: &current,
             skeleton,
             planes: &planes,
+            rules_off,
         };
         let weighted: Vec<UnitWeights> = pass
             .par_iter()
@@ -429,6 +437,7 @@ struct LoosePiece<'a> {
     weights: &'a SurfaceWeights,
     skeleton: &'a Skeleton,
     planes: &'a [Option<Plane>],
+    rules_off: &'a RulesOff,
 }
 
 impl LoosePiece<'_> {
@@ -466,7 +475,7 @@ impl LoosePiece<'_> {
         let mut body_points: Option<Vec<Option<BodyPoint>>> = None;
         let mut contact: Option<Contact> = None;
         let carried: Vec<(u32, DVec3, DVec3)>;
-        let candidates = if holds {
+        let candidates = if holds || !self.rules_off.on(Rule::PiecesContact) {
             candidates
         } else {
             let points = on_body();
@@ -512,7 +521,12 @@ impl LoosePiece<'_> {
                 Some(touch) => self.carried_along(vertices, &touch.vertices, &body_rows),
                 None => body_rows,
             };
-            let Some((kept, keeps)) = on_one_carrier(self.skeleton, &rows) else {
+            let one_carrier = self
+                .rules_off
+                .on(Rule::PiecesOneCarrier)
+                .then(|| on_one_carrier(self.skeleton, &rows))
+                .flatten();
+            let Some((kept, keeps)) = one_carrier else {
                 return UnitWeights {
                     treatment: PieceTreatment::Attached,
                     rows,
@@ -526,7 +540,7 @@ impl LoosePiece<'_> {
                 rows: carried,
             };
         }
-        if size <= longest_bone(candidates, dominant) {
+        if size <= longest_bone(candidates, dominant) && self.rules_off.on(Rule::PiecesSmallRigid) {
             return rigid(dominant);
         }
         // Bent at the joints it holds or, holding none, at the joints of its vertices'
@@ -657,19 +671,25 @@ fn held_bones(
     faces: &[[u32; 3]],
     segments: &[(u32, DVec3, DVec3)],
     nearest_joint: &(dyn Fn(DVec3) -> Option<u32> + Sync),
+    rules_off: &RulesOff,
 ) -> HeldBones {
     let held = held_bones_counting(surface, vertices, faces, segments, samples_inside);
-    let segments = if !held.weakly {
-        held.segments
-    } else if held.segments.is_empty() {
-        bones_around(surface, vertices, held.bounds, segments, nearest_joint)
-    } else {
-        let nearest = NearestJoints::of(surface, vertices, nearest_joint);
-        held.segments
-            .into_iter()
-            .filter(|&(joint, _, _)| 2 * nearest.count(joint) >= vertices.len())
-            .collect()
-    };
+    let segments =
+        if !held.weakly || !rules_off.on(Rule::PiecesPokingBones) && !held.segments.is_empty() {
+            held.segments
+        } else if held.segments.is_empty() {
+            if rules_off.on(Rule::PiecesBonesAround) {
+                bones_around(surface, vertices, held.bounds, segments, nearest_joint)
+            } else {
+                Vec::new()
+            }
+        } else {
+            let nearest = NearestJoints::of(surface, vertices, nearest_joint);
+            held.segments
+                .into_iter()
+                .filter(|&(joint, _, _)| 2 * nearest.count(joint) >= vertices.len())
+                .collect()
+        };
     HeldBones {
         segments,
         mostly: !held.weakly,
@@ -1108,9 +1128,14 @@ mod tests {
             (1, DVec3::new(1.2, -1.0, 0.0), DVec3::new(1.2, 1.0, 0.0)),
             (2, DVec3::new(5.0, 0.0, 0.0), DVec3::new(6.0, 0.0, 0.0)),
         ];
-        let held = held_bones(&ball, &vertices, &ball.triangles, &segments, &|p| {
-            nearest_bone(&segments, p)
-        });
+        let held = held_bones(
+            &ball,
+            &vertices,
+            &ball.triangles,
+            &segments,
+            &|p| nearest_bone(&segments, p),
+            &RulesOff::default(),
+        );
         assert_eq!(joints_of(&held.segments), vec![0]);
         // Bone 3 starts inside and runs out: an eighth of it is inside. Held only when no
         // bone is held for half its length and its bones are the nearest to at least half
@@ -1118,25 +1143,40 @@ mod tests {
         let mut with_tip = segments.to_vec();
         with_tip.push((3, DVec3::new(0.0, 0.9, 0.0), DVec3::new(0.0, 1.9, 0.0)));
         let nearest_tip = |p: DVec3| nearest_bone(&with_tip, p);
-        let held = held_bones(&ball, &vertices, &ball.triangles, &with_tip, &nearest_tip);
+        let held = held_bones(
+            &ball,
+            &vertices,
+            &ball.triangles,
+            &with_tip,
+            &nearest_tip,
+            &RulesOff::default(),
+        );
         assert_eq!(joints_of(&held.segments), vec![0]);
         let tip_only = [with_tip[2], with_tip[3]];
-        let held = held_bones(&ball, &vertices, &ball.triangles, &tip_only, &|p| {
-            nearest_bone(&tip_only, p)
-        });
+        let held = held_bones(
+            &ball,
+            &vertices,
+            &ball.triangles,
+            &tip_only,
+            &|p| nearest_bone(&tip_only, p),
+            &RulesOff::default(),
+        );
         assert_eq!(joints_of(&held.segments), vec![3]);
         let cap = faces_above(&ball, 0.8);
         assert!(!cap.is_empty());
         let mut cap_vertices: Vec<u32> = cap.iter().flatten().copied().collect();
         cap_vertices.sort_unstable();
         cap_vertices.dedup();
-        assert!(
-            held_bones(&ball, &cap_vertices, &cap, &segments, &|p| nearest_bone(
-                &segments, p
-            ))
-            .segments
-            .is_empty()
-        );
+        assert!(held_bones(
+            &ball,
+            &cap_vertices,
+            &cap,
+            &segments,
+            &|p| nearest_bone(&segments, p),
+            &RulesOff::default()
+        )
+        .segments
+        .is_empty());
     }
 
     #[test]
@@ -1146,9 +1186,14 @@ mod tests {
         let vertices: Vec<u32> = (0..ball.positions.len() as u32).collect();
         let far = (1, DVec3::new(5.0, 0.0, 0.0), DVec3::new(6.0, 0.0, 0.0));
         let held_with = |segments: &[(u32, DVec3, DVec3)]| {
-            held_bones(&ball, &vertices, &ball.triangles, segments, &|p| {
-                nearest_bone(segments, p)
-            })
+            held_bones(
+                &ball,
+                &vertices,
+                &ball.triangles,
+                segments,
+                &|p| nearest_bone(segments, p),
+                &RulesOff::default(),
+            )
             .segments
         };
         // Joint 0 sits outside the ball but inside its box, its bone running away from it:
@@ -1238,16 +1283,26 @@ mod tests {
         let across = (0, DVec3::new(0.3, -0.42, 0.0), DVec3::new(0.3, 0.38, 0.0));
         let along = (1, DVec3::new(0.0, 0.4, 0.0), DVec3::new(4.0, 0.4, 0.0));
         let segments = [across, along];
-        let held = held_bones(&strap, &vertices, &strap.triangles, &segments, &|p| {
-            nearest_bone(&segments, p)
-        });
+        let held = held_bones(
+            &strap,
+            &vertices,
+            &strap.triangles,
+            &segments,
+            &|p| nearest_bone(&segments, p),
+            &RulesOff::default(),
+        );
         assert!(held.segments.is_empty(), "{:?}", held.segments);
         // With the other bone far away, the bone that pokes in is the nearest to all of it.
         let far = (1, DVec3::new(0.0, 5.0, 0.0), DVec3::new(4.0, 5.0, 0.0));
         let segments = [across, far];
-        let held = held_bones(&strap, &vertices, &strap.triangles, &segments, &|p| {
-            nearest_bone(&segments, p)
-        });
+        let held = held_bones(
+            &strap,
+            &vertices,
+            &strap.triangles,
+            &segments,
+            &|p| nearest_bone(&segments, p),
+            &RulesOff::default(),
+        );
         assert_eq!(joints_of(&held.segments), vec![0]);
     }
 

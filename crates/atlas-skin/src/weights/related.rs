@@ -61,14 +61,3 @@ pub fn related_regions(
         out.truncate(keep);
     })
 }
-
-/// Transpose of `related`: the vertices each region reaches, increasing.
-pub fn region_vertices(decomposition: &Decomposition, related: &Rows<(u32, f64)>) -> Vec<Vec<u32>> {
-    let mut region_vertices: Vec<Vec<u32>> = vec![Vec::new(); decomposition.regions.len()];
-    for v in 0..decomposition.surface.vertex_count() {
-        for &(r, _) in related.row(v) {
-            region_vertices[r as usize].push(v as u32);
-        }
-    }
-    region_vertices
-}

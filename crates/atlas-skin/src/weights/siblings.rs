@@ -1,4 +1,4 @@
-//! Step 3c of the weights: blends between sibling joints pass through their common
+//! Step 3b of the weights: blends between sibling joints pass through their common
 //! ancestor (issue 13, item 1).
 //!
 //! Two joints j and k of which neither is an ancestor of the other (two thighs, a neck and a
@@ -26,10 +26,8 @@
 //!   w'_j = w_j − c_j Σ_k t_jk,   w'_a = w_a + Σ_{(j,k): a} (c_j + c_k) t_jk.
 //!
 //! Weight only moves between joints, so the row still sums to 1; every term is continuous
-//! in w and in the distances, so the weights stay continuous over the surface. Joints of
-//! leaf patches (step 3b: bones lying in the skin, such as a face's) are not paired: their
-//! skin is meant to slide between them. Measured on the benchmark in
-//! docs/measurements.md, "Sibling blends through their common ancestor".
+//! in w and in the distances, so the weights stay continuous over the surface. Measured on
+//! the benchmark in docs/measurements.md, "Sibling blends through their common ancestor".
 
 use super::blend::beta;
 use super::surface_weights::SurfaceWeights;
@@ -58,16 +56,14 @@ pub const FAR_RATIO: f64 = 1.6;
 /// - `joint_bones`: the bone segments of `skeleton` keyed by joint, for the d_x.
 /// - `owns_skin`: per joint, whether it may take weight (an ancestor that owns no skin
 ///   takes none).
-/// - `sliding`: joints whose blends are left alone (leaf patches).
 pub fn merge_sibling_blends(
     skeleton: &Skeleton,
     positions: &[DVec3],
     joint_bones: &JointBones,
     owns_skin: &[bool],
-    sliding: &[u32],
     weights: &mut SurfaceWeights,
 ) -> usize {
-    let family = Family::new(skeleton, joint_bones, owns_skin, sliding);
+    let family = Family::new(skeleton, joint_bones, owns_skin);
     let mut row = Vec::new();
     let merge = |source: &SurfaceWeights, v: usize, row: &mut Vec<(u32, f64)>| {
         row.clear();
@@ -96,29 +92,18 @@ struct Family<'a> {
     depths: Vec<u32>,
     bones: &'a JointBones,
     owns_skin: Vec<bool>,
-    paired: Vec<bool>,
 }
 
 impl<'a> Family<'a> {
-    fn new(
-        skeleton: &Skeleton,
-        bones: &'a JointBones,
-        owns_skin: &[bool],
-        sliding: &[u32],
-    ) -> Self {
+    fn new(skeleton: &Skeleton, bones: &'a JointBones, owns_skin: &[bool]) -> Self {
         let parents: Vec<Option<u32>> = (0..skeleton.len())
             .map(|j| skeleton.parent(j).map(|p| p as u32))
             .collect();
-        let mut paired = vec![true; skeleton.len()];
-        for &j in sliding {
-            paired[j as usize] = false;
-        }
         Self {
             depths: depths(skeleton),
             parents,
             bones,
             owns_skin: owns_skin.to_vec(),
-            paired,
         }
     }
 
@@ -170,9 +155,6 @@ impl<'a> Family<'a> {
         for x in 0..row.len() {
             for y in x + 1..row.len() {
                 let ((j, wj), (k, wk)) = (row[x], row[y]);
-                if !self.paired[j as usize] || !self.paired[k as usize] {
-                    continue;
-                }
                 let Some(a) = self.sibling_ancestor(j, k) else {
                     continue;
                 };
@@ -220,7 +202,7 @@ impl<'a> Family<'a> {
 
 /// Each joint's depth (its number of ancestors), parents first in one pass: walking up
 /// from every joint would cost the square of a chain's length.
-fn depths(skeleton: &Skeleton) -> Vec<u32> {
+pub(crate) fn depths(skeleton: &Skeleton) -> Vec<u32> {
     let mut depths = vec![0; skeleton.len()];
     for j in skeleton.topological_order() {
         if let Some(p) = skeleton.parent(j) {
@@ -257,12 +239,7 @@ mod tests {
         .unwrap()
     }
 
-    fn merged(
-        skeleton: &Skeleton,
-        p: DVec3,
-        row: &[(u32, f64)],
-        sliding: &[u32],
-    ) -> Vec<(u32, f64)> {
+    fn merged(skeleton: &Skeleton, p: DVec3, row: &[(u32, f64)]) -> Vec<(u32, f64)> {
         let mut weights = SurfaceWeights {
             offsets: vec![0],
             ..SurfaceWeights::default()
@@ -273,7 +250,6 @@ mod tests {
             &[p],
             &JointBones::new(&bone_segments(skeleton)),
             &vec![true; skeleton.len()],
-            sliding,
             &mut weights,
         );
         let mut row: Vec<(u32, f64)> = weights.row(0).collect();
@@ -322,7 +298,7 @@ mod tests {
         let joint_bones = JointBones::new(&bone_segments(&skeleton));
         let owns_skin = vec![true; skeleton.len()];
         let merge = |weights: &mut SurfaceWeights, positions: &[DVec3]| {
-            merge_sibling_blends(&skeleton, positions, &joint_bones, &owns_skin, &[], weights)
+            merge_sibling_blends(&skeleton, positions, &joint_bones, &owns_skin, weights)
         };
         let before = weights.clone();
         // Without the crotch nothing changes.
@@ -337,7 +313,7 @@ mod tests {
                 before.row(v).collect::<Vec<_>>()
             );
         }
-        let crotch_row = merged(&skeleton, crotch, rows[1], &[]);
+        let crotch_row = merged(&skeleton, crotch, rows[1]);
         let mut row: Vec<(u32, f64)> = weights.row(1).collect();
         row.sort_by_key(|e| e.0);
         assert_eq!(row, crotch_row);
@@ -350,7 +326,7 @@ mod tests {
         // is 0.112 from each and 0.071 from the pelvis's bones (to the hips, to the spine).
         let skeleton = legs(0.1);
         let p = DVec3::new(0.0, -0.05, 0.05);
-        let row = merged(&skeleton, p, &[(2, 0.5), (4, 0.5)], &[]);
+        let row = merged(&skeleton, p, &[(2, 0.5), (4, 0.5)]);
         // Each thigh gives s · (½ − m₀) / (1 − 2 m₀) = s / 2 of its ½.
         let given = SHARE * 0.5;
         assert!((weight(&row, 0) - 2.0 * given).abs() < 1e-12, "{row:?}");
@@ -366,27 +342,24 @@ mod tests {
         // inside the fade) ...
         let skeleton = legs(0.5);
         let near = DVec3::new(0.0, -0.6, 0.0);
-        let row = merged(&skeleton, near, &[(2, 0.5), (4, 0.5)], &[]);
+        let row = merged(&skeleton, near, &[(2, 0.5), (4, 0.5)]);
         assert!(weight(&row, 0) > 0.0 && weight(&row, 0) < SHARE, "{row:?}");
         // ... and at y = −1 it is 1 from them against the thighs' 0.5 (ratio 2 > ρ₁).
         let far = DVec3::new(0.0, -1.0, 0.0);
-        let row = merged(&skeleton, far, &[(2, 0.5), (4, 0.5)], &[]);
+        let row = merged(&skeleton, far, &[(2, 0.5), (4, 0.5)]);
         assert_eq!(row, vec![(2, 0.5), (4, 0.5)]);
     }
 
     #[test]
-    fn parents_and_children_tails_and_sliding_joints_are_left_alone() {
+    fn parents_and_children_and_tails_are_left_alone() {
         let skeleton = legs(0.1);
         let p = DVec3::new(0.05, -0.05, 0.05);
         // A thigh and its own knee: not siblings.
         let row = [(2, 0.5), (3, 0.5)];
-        assert_eq!(merged(&skeleton, p, &row, &[]), row.to_vec());
+        assert_eq!(merged(&skeleton, p, &row), row.to_vec());
         // A common weight of m₀ or less is a transition's tail.
         let row = [(2, 1.0 - TAIL), (4, TAIL)];
-        assert_eq!(merged(&skeleton, p, &row, &[]), row.to_vec());
-        // Leaf patches slide.
-        let row = [(2, 0.5), (4, 0.5)];
-        assert_eq!(merged(&skeleton, p, &row, &[4]), row.to_vec());
+        assert_eq!(merged(&skeleton, p, &row), row.to_vec());
     }
 
     #[test]
@@ -416,13 +389,13 @@ mod tests {
         let h = 1e-7;
         for step in 0..100 {
             let t = step as f64 / 100.0;
-            let out = merged(&skeleton, p, &row(t), &[]);
+            let out = merged(&skeleton, p, &row(t));
             assert!(out.iter().all(|e| e.1 >= 0.0), "{out:?}");
             assert!(
                 (out.iter().map(|e| e.1).sum::<f64>() - 1.0).abs() < 1e-12,
                 "{out:?}"
             );
-            let next = merged(&skeleton, p, &row(t + h), &[]);
+            let next = merged(&skeleton, p, &row(t + h));
             let change: f64 = (0..skeleton.len() as u32)
                 .map(|j| (weight(&next, j) - weight(&out, j)).abs())
                 .sum();

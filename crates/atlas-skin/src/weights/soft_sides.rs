@@ -4,6 +4,7 @@
 
 use super::blend::beta;
 use super::ownership::{FreeBones, Ownership, OwnershipBones};
+use crate::ablation::{Rule, RulesOff};
 use crate::decomposition::{Boundary, BoundaryKind, Decomposition};
 use crate::geometry::point_segment_distance;
 use crate::overlap::Overlaps;
@@ -76,6 +77,7 @@ pub fn soft_sides(
     skeleton: &Skeleton,
     overlaps: &Overlaps,
     related: &Rows<(u32, f64)>,
+    rules_off: &RulesOff,
 ) -> Vec<SoftSide> {
     let d = decomposition;
     let segments = bone_segments(skeleton);
@@ -101,6 +103,7 @@ pub fn soft_sides(
         .chain(
             continued_boundaries(d, skeleton)
                 .into_iter()
+                .filter(|_| rules_off.on(Rule::ContinuedSoftSides))
                 .map(|(k, b)| (k, Cow::Owned(b))),
         )
         .collect();
@@ -122,8 +125,14 @@ pub fn soft_sides(
         let has_children = !children[b.joint as usize].is_empty();
         let seeds = Seeds {
             vertices: &vertices,
-            beyond_nearest: has_children || b.leaf_part_past,
-            own_part: has_children && !b.bone_through && !bound[b.joint as usize],
+            far_ends: rules_off.on(Rule::FarEndSeeds),
+            beyond_nearest: (has_children || b.leaf_part_past) && rules_off.on(Rule::FartherSeeds),
+            own_part: has_children
+                && !b.bone_through
+                && !bound[b.joint as usize]
+                && rules_off.on(Rule::OwnPartSeeds),
+            kappa: rules_off.on(Rule::OwnPart),
+            past_plane: rules_off.on(Rule::PastPlane),
         };
         let below = |v: usize| taken.below(&bones, v, b.parent_region, b.joint);
         child_side(d, b, half_width, &owner, &beyond, in_region, below, &seeds)
@@ -287,8 +296,14 @@ impl<'a> NearVertices<'a> {
 /// child bones that no region is bound to and that no other bone runs through).
 struct Seeds<'a> {
     vertices: &'a NearVertices<'a>,
+    /// Whether the far ends of the edges spanning the band may seed it.
+    far_ends: bool,
     beyond_nearest: bool,
     own_part: bool,
+    /// Whether κ_c applies (else 1) and π_c (else 0): developer switches
+    /// ([`crate::ablation`]).
+    kappa: bool,
+    past_plane: bool,
 }
 
 /// The child side of the soft boundary `b` (half-width `half_width`, κ from `owner`, π from
@@ -326,11 +341,15 @@ fn child_side(
         let p = positions[v as usize];
         let side = signed(v as usize);
         // π_c matters only where the plane's own term is below 1.
-        let past = if side < half_width { beyond.at(p) } else { 0.0 };
+        let past = if side < half_width && seeds.past_plane {
+            beyond.at(p)
+        } else {
+            0.0
+        };
         if side <= -half_width && past <= 0.0 {
             return;
         }
-        let kappa = owner.at(p);
+        let kappa = if seeds.kappa { owner.at(p) } else { 1.0 };
         if kappa > 0.0 {
             reached.push((v, kappa, past));
             queue.push_back(v);
@@ -357,7 +376,7 @@ fn child_side(
     for &v in &near {
         visit(v, &mut queue);
     }
-    if queue.is_empty() {
+    if queue.is_empty() && seeds.far_ends {
         for u in far_ends(&near) {
             visit(u, &mut queue);
         }
@@ -367,7 +386,7 @@ fn child_side(
         for &v in &farther {
             visit(v, &mut queue);
         }
-        if queue.is_empty() && b.leaf_part_past {
+        if queue.is_empty() && b.leaf_part_past && seeds.far_ends {
             for u in far_ends(&farther) {
                 visit(u, &mut queue);
             }

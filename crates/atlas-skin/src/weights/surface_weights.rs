@@ -68,17 +68,10 @@ pub struct WeightCounts {
     pub gaps: Vec<GapWeighting>,
     /// Joints whose soft boundary is inactive (no cross-section near the joint).
     pub inactive_soft_joints: Vec<u32>,
-    /// Leaf joints that move a patch of skin (step 3b).
-    pub leaf_patches: Vec<u32>,
     /// Vertices whose weights on far joints the guard removed (step 4).
     pub far_bone_vertices: usize,
-    /// Vertices whose sibling blends gave weight to the siblings' common ancestor (step 3c).
+    /// Vertices whose sibling blends gave weight to the siblings' common ancestor (step 3b).
     pub sibling_blend_vertices: usize,
-    /// Joints at the point of other joints that the rules left without weight and that
-    /// now share their twins' weight (step 6).
-    pub twins_given_a_share: Vec<u32>,
-    /// Joints of the classes of twins too large to share their weight (step 6).
-    pub twins_too_many_to_share: usize,
 }
 
 /// How a piece was weighted.
