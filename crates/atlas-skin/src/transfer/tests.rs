@@ -162,7 +162,12 @@ fn constant_weights_are_carried_exactly() {
         })
         .collect();
     let mut triangles = Vec::new();
-    quad_grid((n - 1) as usize, (n - 1) as usize, |y, x| y as u32 * n + x as u32, &mut triangles);
+    quad_grid(
+        (n - 1) as usize,
+        (n - 1) as usize,
+        |y, x| y as u32 * n + x as u32,
+        &mut triangles,
+    );
     let result = transfer_weights(&source, &plane, &triangles, &TransferParams::default()).unwrap();
     assert!(result.counts.matched > 0 && result.counts.inpainted > result.counts.matched);
     for v in 0..plane.len() {
