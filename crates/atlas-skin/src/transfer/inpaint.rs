@@ -24,7 +24,7 @@
 //!
 //! The rows of Q of unknown vertices are assembled directly: Q_ij = −L_ij +
 //! Σ_m L_im L_mj / M_mm over the neighbours m of i (and i itself), so only the two-ring of
-//! each unknown vertex is visited. [`dense_reference`] (tests) solves the same system
+//! each unknown vertex is visited. `dense_reference` (tests) solves the same system
 //! densely.
 
 use super::cotangent::Operators;
