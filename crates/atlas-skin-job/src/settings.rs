@@ -34,7 +34,7 @@ pub enum SettingsError {
 #[derive(Debug, Clone, Default)]
 pub struct Settings {
     /// A settings file: [`SkinParams`] as JSON (any subset of `decompose`, `overlap`
-    /// {`factor`, `per_joint`}, `blend`, `binding`, `max_influences`).
+    /// {`factor`, `per_joint`}, `blend`, `binding`, `loose_pieces`, `max_influences`).
     pub config: Option<PathBuf>,
     /// Overlap half-width as a multiple of each boundary's diameter.
     pub overlap: Option<f64>,

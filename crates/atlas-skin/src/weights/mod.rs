@@ -85,6 +85,7 @@ pub mod chains;
 pub mod guard;
 pub mod ownership;
 pub mod pieces;
+pub mod pieces_by_transfer;
 pub mod related;
 pub mod rigid;
 pub mod siblings;
