@@ -25,6 +25,17 @@ def polled(cls, context, find):
     return True
 
 
+def max_influences_property():
+    """The Max Influences option of the add-on's operators."""
+    return IntProperty(
+        name="Max Influences",
+        description="Bones kept per vertex (the largest weights, renormalised)",
+        default=4,
+        min=1,
+        max=32,
+    )
+
+
 def selection(context):
     """(armature, meshes) of the selection, or a sentence saying what is missing."""
     selected = context.selected_objects
@@ -58,13 +69,7 @@ class OBJECT_OT_parent_atlas_skin(bpy.types.Operator):
         description="Overlap of single bones, as BONE=FACTOR, comma-separated: from "
         "quasi-rigid (small) to soft (large)",
     )
-    max_influences: IntProperty(
-        name="Max Influences",
-        description="Bones kept per vertex (the largest weights, renormalised)",
-        default=4,
-        min=1,
-        max=32,
-    )
+    max_influences: max_influences_property()
     blend: EnumProperty(
         name="Blend",
         description="How overlapping parts are blended",

@@ -10,7 +10,7 @@ from bpy.props import BoolProperty, FloatProperty, IntProperty
 
 from .binding import bind_to_armature, write_groups
 from .body import BodyError, read_body, rest_state
-from .operator import polled
+from .operator import max_influences_property, polled
 from .package import MissingPackage, atlas_skin
 from .rig import RigError, deforming_rig
 
@@ -86,13 +86,7 @@ class OBJECT_OT_transfer_atlas_skin(bpy.types.Operator):
         min=0,
         soft_max=100,
     )
-    max_influences: IntProperty(
-        name="Max Influences",
-        description="Bones kept per vertex (the largest weights, renormalised)",
-        default=4,
-        min=1,
-        max=32,
-    )
+    max_influences: max_influences_property()
 
     @classmethod
     def poll(cls, context):
