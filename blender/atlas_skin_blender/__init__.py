@@ -5,6 +5,9 @@ later, also installable the legacy way) that weights meshes to an armature with 
 Object > Parent > With Atlas-Skin Weights, or the object context menu with an armature
 active: the selected meshes, as one body, get one vertex group per deforming bone of the
 selected armature, an Armature modifier and the armature as parent.
+
+Object > Transfer Atlas-Skin Weights from Active: the selected meshes (clothes, hair,
+props) take the weights of the active skinned mesh (weight transfer with inpainting).
 """
 
 # Read by Blender only for a legacy install; an extension is described by
@@ -22,15 +25,20 @@ bl_info = {
 import bpy
 
 from .operator import OBJECT_OT_parent_atlas_skin, draw_context_menu, draw_parent_menu
+from .transfer_operator import OBJECT_OT_transfer_atlas_skin, draw_transfer_menu
 
 
 def register():
     bpy.utils.register_class(OBJECT_OT_parent_atlas_skin)
     bpy.types.VIEW3D_MT_object_parent.prepend(draw_parent_menu)
     bpy.types.VIEW3D_MT_object_context_menu.append(draw_context_menu)
+    bpy.utils.register_class(OBJECT_OT_transfer_atlas_skin)
+    bpy.types.VIEW3D_MT_object.append(draw_transfer_menu)
 
 
 def unregister():
+    bpy.types.VIEW3D_MT_object.remove(draw_transfer_menu)
+    bpy.utils.unregister_class(OBJECT_OT_transfer_atlas_skin)
     bpy.types.VIEW3D_MT_object_context_menu.remove(draw_context_menu)
     bpy.types.VIEW3D_MT_object_parent.remove(draw_parent_menu)
     bpy.utils.unregister_class(OBJECT_OT_parent_atlas_skin)

@@ -34,6 +34,30 @@ class Rejected(Exception):
     """The quality gate (the Fail On option) refused the weights (the message says why)."""
 
 
+def polled(cls, context, find):
+    """An operator's poll: Object Mode and a selection `find(context)` accepts (else the
+    sentence it returns is shown as the reason)."""
+    if context.mode != "OBJECT":
+        cls.poll_message_set("works in Object Mode")
+        return False
+    found = find(context)
+    if isinstance(found, str):
+        cls.poll_message_set(found)
+        return False
+    return True
+
+
+def max_influences_property():
+    """The Max Influences option of the add-on's operators."""
+    return IntProperty(
+        name="Max Influences",
+        description="Bones kept per vertex (the largest weights, renormalised)",
+        default=4,
+        min=1,
+        max=32,
+    )
+
+
 def selection(context):
     """(armature, meshes) of the selection, or a sentence saying what is missing."""
     selected = context.selected_objects
@@ -67,13 +91,7 @@ class OBJECT_OT_parent_atlas_skin(bpy.types.Operator):
         description="Overlap of single bones, as BONE=FACTOR, comma-separated: from "
         "quasi-rigid (small) to soft (large)",
     )
-    max_influences: IntProperty(
-        name="Max Influences",
-        description="Bones kept per vertex (the largest weights, renormalised)",
-        default=4,
-        min=1,
-        max=32,
-    )
+    max_influences: max_influences_property()
     blend: EnumProperty(
         name="Blend",
         description="How overlapping parts are blended",
@@ -124,14 +142,7 @@ class OBJECT_OT_parent_atlas_skin(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        if context.mode != "OBJECT":
-            cls.poll_message_set("works in Object Mode")
-            return False
-        found = selection(context)
-        if isinstance(found, str):
-            cls.poll_message_set(found)
-            return False
-        return True
+        return polled(cls, context, selection)
 
     def execute(self, context):
         armature, meshes = selection(context)

@@ -17,7 +17,8 @@ skeleton, all imported with Blender's glTF importer and their weights removed:
 - running again gives the same groups, bit for bit; undo takes everything back;
 - Blender's own "With Automatic Weights" is timed on the same meshes (printed beside the
   add-on's time, with the vertices it leaves in no group; not asserted).
-Then: the redo options against the command line's, the error paths, modifiers, and a
+Then: the redo options against the command line's, the error paths, modifiers, the
+transfer operator (transfer_checks.py), and a
 Workbench render of the posed KayKit character coloured by its weights (the README's).
 
 Usage: python parent_with_atlas_skin.py EXTENSION.zip ATLAS_SKIN DATA_DIR OUT_DIR
@@ -34,6 +35,7 @@ from fresh_user import USER  # first: Blender reads the user folder when bpy is 
 import bpy
 import numpy as np
 from mathutils import Matrix, Vector
+from transfer_checks import check_transfer
 from skinned import (
     TOLERANCE,
     bone_weights,
@@ -423,6 +425,7 @@ def main():
     check_errors(demo)
     check_quality_gate(demo)
     check_modifiers(demo)
+    check_transfer(knight)
     render_screenshot(
         os.path.join(OUT, "blender-addon.png"),
         [(demo, DEMO_POSE), (knight, KNIGHT_POSE)],

@@ -38,6 +38,9 @@ enum Command {
     Eval(cmd::eval::Args),
     /// Write a self-contained HTML report with an interactive 3D view.
     Report(cmd::report::Args),
+    /// Carry a skinned character's weights onto clothes, hair and props (or re-weight
+    /// some of its meshes from the others).
+    Transfer(cmd::transfer::Args),
 }
 
 /// Makes the main thread one of the global thread pool's workers (the pool starts one
@@ -65,6 +68,7 @@ fn main() -> ExitCode {
         Command::Bench(args) => cmd::bench::run(args),
         Command::Eval(args) => cmd::eval::run(args),
         Command::Report(args) => cmd::report::run(args),
+        Command::Transfer(args) => cmd::transfer::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -51,8 +51,8 @@ struct SettingsFile<'a> {
 #[derive(Debug, Clone, Default)]
 pub struct Settings {
     /// A settings file: [`SkinParams`] as JSON (any subset of `decompose`, `overlap`
-    /// {`factor`, `per_joint`}, `blend`, `binding`, `max_influences`), and `fail_on` (the
-    /// quality gate's conditions, [`Condition`] names).
+    /// {`factor`, `per_joint`}, `blend`, `binding`, `loose_pieces`, `max_influences`), and
+    /// `fail_on` (the quality gate's conditions, [`Condition`] names).
     pub config: Option<PathBuf>,
     /// Overlap half-width as a multiple of each boundary's diameter.
     pub overlap: Option<f64>,

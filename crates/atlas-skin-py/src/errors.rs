@@ -5,6 +5,7 @@
 
 use atlas_skin_io::IoError;
 use atlas_skin_job::quality::Verdict;
+use atlas_skin_job::transfer::TransferJobError;
 use atlas_skin_job::{error_chain, JobError, SettingsError};
 use pyo3::exceptions::{PyException, PyFileNotFoundError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -47,14 +48,30 @@ pub fn rejected(
 
 /// `error` as a Python exception (see the module documentation).
 pub fn to_py_err(error: &JobError) -> PyErr {
-    let message = error_chain(error);
     let missing = match error {
-        JobError::Io(IoError::Read { cause, .. }) => cause.kind() == std::io::ErrorKind::NotFound,
+        JobError::Io(io) => io_missing(io),
         JobError::Settings(SettingsError::Read { source, .. }) => {
             source.kind() == std::io::ErrorKind::NotFound
         }
         _ => false,
     };
+    raise(error, missing)
+}
+
+/// A transfer job's `error` as a Python exception (see the module documentation).
+pub fn transfer_to_py_err(error: &TransferJobError) -> PyErr {
+    let missing = matches!(error, TransferJobError::Io(io) if io_missing(io));
+    raise(error, missing)
+}
+
+/// Whether `error` is a file that is not there.
+fn io_missing(error: &IoError) -> bool {
+    matches!(error, IoError::Read { cause, .. } if cause.kind() == std::io::ErrorKind::NotFound)
+}
+
+/// `FileNotFoundError` when `missing`, else `ValueError`, with `error`'s chain.
+fn raise(error: &dyn std::error::Error, missing: bool) -> PyErr {
+    let message = error_chain(error);
     if missing {
         PyFileNotFoundError::new_err(message)
     } else {

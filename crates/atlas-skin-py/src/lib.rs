@@ -1,15 +1,17 @@
 //! The Python package `atlas_skin` (its native module `atlas_skin._atlas_skin`): the
 //! method on numpy arrays (`compute_weights`), characters read into numpy (`load`, `demo`),
 //! posing (`deform_lbs`, `deform_dqs`), the file job of `atlas-skin skin` (`skin_file`)
-//! and of `atlas-skin batch` (`batch`); `fail_on` (the quality gate) raises
+//! and of `atlas-skin batch` (`batch`), weight transfer on arrays (`transfer`) and the job
+//! of `atlas-skin transfer` (`transfer_file`); `fail_on` (the quality gate) raises
 //! `QualityGateError`. The GIL is released while Rust works; the signatures and their
 //! documentation are in `python/atlas_skin/_atlas_skin.pyi`.
 
 mod arrays;
 mod errors;
 
-use crate::errors::{no_panic, rejected, to_py_err, QualityGateError};
+use crate::errors::{no_panic, rejected, to_py_err, transfer_to_py_err, QualityGateError};
 use atlas_skin::pipeline::{skin, SkinInput};
+use atlas_skin::transfer::{transfer_weights, TransferParams, TransferSource};
 use atlas_skin::weights::blend::Blend;
 use atlas_skin::weights::rigid::Binding;
 use atlas_skin_io::gltf::MAX_INFLUENCES;
@@ -19,6 +21,7 @@ use atlas_skin_job::batch::{
 };
 use atlas_skin_job::quality::{Condition, Findings, Verdict};
 use atlas_skin_job::report::{skin_report, stage_timings};
+use atlas_skin_job::transfer::TransferJob;
 use atlas_skin_job::{error_chain, Input, JobError, Outputs, Settings, SkinJob};
 use atlas_skin_runtime::{reference, Skeleton, NO_PARENT};
 use glam::Vec3;
@@ -543,6 +546,153 @@ fn batch<'py>(
     )
 }
 
+/// Weight transfer on numpy arrays (`atlas_skin.transfer`): the source's weights carried
+/// onto the target ([`atlas_skin::transfer`]); returns the target's `(V, K)` indices and
+/// weights (the `max_influences` largest, renormalised) and what happened as a dict.
+#[allow(clippy::too_many_arguments)]
+#[pyfunction]
+#[pyo3(signature = (
+    source_vertices, source_triangles, source_indices, source_weights, target_vertices,
+    target_triangles, *, joint_count=None, max_influences=4, distance=None,
+    angle_degrees=None, flipped_normals=None, smooth_iterations=None, smooth_alpha=None
+))]
+fn transfer<'py>(
+    py: Python<'py>,
+    source_vertices: &Bound<'py, PyAny>,
+    source_triangles: &Bound<'py, PyAny>,
+    source_indices: &Bound<'py, PyAny>,
+    source_weights: &Bound<'py, PyAny>,
+    target_vertices: &Bound<'py, PyAny>,
+    target_triangles: &Bound<'py, PyAny>,
+    joint_count: Option<usize>,
+    max_influences: usize,
+    distance: Option<f64>,
+    angle_degrees: Option<f64>,
+    flipped_normals: Option<bool>,
+    smooth_iterations: Option<usize>,
+    smooth_alpha: Option<f64>,
+) -> PyResult<Bound<'py, PyTuple>> {
+    if !(1..=MAX_INFLUENCES).contains(&max_influences) {
+        return Err(PyValueError::new_err(format!(
+            "max_influences {max_influences} is outside 1..={MAX_INFLUENCES}"
+        )));
+    }
+    let params = transfer_params(
+        distance,
+        angle_degrees,
+        flipped_normals,
+        smooth_iterations,
+        smooth_alpha,
+    );
+    let positions = arrays::points(source_vertices, "source_vertices", 'V')?;
+    let triangles = arrays::triangles(source_triangles, positions.len())?;
+    let joints = joint_count.unwrap_or(u32::MAX as usize);
+    let weights = arrays::vertex_weights(source_indices, source_weights, positions.len(), joints)?;
+    let joints =
+        joint_count.unwrap_or_else(|| weights.joints.iter().max().map_or(0, |&j| j as usize + 1));
+    let targets = arrays::points(target_vertices, "target_vertices", 'V')?;
+    let target_faces = arrays::triangles(target_triangles, targets.len())?;
+    let result = py.detach(|| {
+        no_panic(|| {
+            let source = TransferSource::new(&positions, &triangles, &weights, joints)
+                .map_err(|e| PyValueError::new_err(format!("the source: {}", error_chain(&e))))?;
+            transfer_weights(&source, &targets, &target_faces, &params)
+                .map_err(|e| PyValueError::new_err(format!("the target: {}", error_chain(&e))))
+        })
+    })?;
+    let (indices, values) =
+        arrays::weights_arrays(py, &result.weights.pruned(max_influences), max_influences)?;
+    let info = serde_json::json!({
+        "counts": result.counts,
+        "pieces": result.pieces,
+        "distance": result.distance,
+        "vertex_sources": result.vertex_sources.iter().map(|s| s.name()).collect::<Vec<_>>(),
+    });
+    PyTuple::new(
+        py,
+        [
+            indices.into_any(),
+            values.into_any(),
+            json_object(py, &info)?,
+        ],
+    )
+}
+
+/// The transfer settings from the keyword arguments (`None`: the default).
+fn transfer_params(
+    distance: Option<f64>,
+    angle_degrees: Option<f64>,
+    flipped_normals: Option<bool>,
+    smooth_iterations: Option<usize>,
+    smooth_alpha: Option<f64>,
+) -> TransferParams {
+    let default = TransferParams::default();
+    TransferParams {
+        distance: distance.unwrap_or(default.distance),
+        angle_degrees: angle_degrees.unwrap_or(default.angle_degrees),
+        flipped_normals: flipped_normals.unwrap_or(default.flipped_normals),
+        smooth_iterations: smooth_iterations.unwrap_or(default.smooth_iterations),
+        smooth_alpha: smooth_alpha.unwrap_or(default.smooth_alpha),
+    }
+}
+
+/// The job of `atlas-skin transfer` (`atlas_skin.transfer_file`); returns the report.
+#[allow(clippy::too_many_arguments)]
+#[pyfunction]
+#[pyo3(signature = (
+    source, targets, output, *, meshes=None, report=None, html=None, skeleton=None,
+    weights=None, max_influences=4, distance=None, angle_degrees=None,
+    flipped_normals=None, smooth_iterations=None, smooth_alpha=None
+))]
+fn transfer_file<'py>(
+    py: Python<'py>,
+    source: PathBuf,
+    targets: Vec<PathBuf>,
+    output: PathBuf,
+    meshes: Option<Vec<String>>,
+    report: Option<PathBuf>,
+    html: Option<PathBuf>,
+    skeleton: Option<PathBuf>,
+    weights: Option<PathBuf>,
+    max_influences: usize,
+    distance: Option<f64>,
+    angle_degrees: Option<f64>,
+    flipped_normals: Option<bool>,
+    smooth_iterations: Option<usize>,
+    smooth_alpha: Option<f64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let job = TransferJob {
+        source: Input {
+            path: Some(source),
+            load: LoadOptions {
+                skeleton,
+                group: None,
+                weights,
+            },
+        },
+        targets,
+        meshes: meshes.unwrap_or_default(),
+        params: transfer_params(
+            distance,
+            angle_degrees,
+            flipped_normals,
+            smooth_iterations,
+            smooth_alpha,
+        ),
+        max_influences,
+        outputs: Outputs {
+            glb: output,
+            report,
+            html,
+            ..Outputs::default()
+        },
+        keep_report: true,
+    };
+    let outcome =
+        py.detach(|| no_panic(|| job.run(&mut |_| {}).map_err(|e| transfer_to_py_err(&e))))?;
+    json_object(py, &outcome.report.unwrap_or_default())
+}
+
 #[pymodule]
 fn _atlas_skin(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
@@ -553,5 +703,7 @@ fn _atlas_skin(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(deform, m)?)?;
     m.add_function(wrap_pyfunction!(skin_file, m)?)?;
     m.add_function(wrap_pyfunction!(batch, m)?)?;
+    m.add_function(wrap_pyfunction!(transfer, m)?)?;
+    m.add_function(wrap_pyfunction!(transfer_file, m)?)?;
     Ok(())
 }

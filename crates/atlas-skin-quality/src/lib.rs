@@ -19,3 +19,5 @@ pub mod run;
 pub mod scoring;
 pub mod single_joint;
 pub mod stats;
+pub mod transfer_peers;
+pub mod transfer_split;

@@ -14,6 +14,7 @@
 //! | regions of the split surface, the joints bound to them | §3.2 | [`regions`] |
 //! | the decomposition driver: §3.1, then §3.2 | §3.1–3.2 | [`decompose()`] |
 //! | overlaps: surface distances from each cut, widths | §3.3 | [`overlap`] |
+//! | weights carried from a skinned surface onto other meshes: closest points, inpainting (Abdrashitov et al. 2023) | | [`transfer`] |
 //! | weights: blending, chains, soft boundaries, pieces, rigid binding | §4, §5 | [`weights`] |
 //! | what the report shows of a decomposition, and its warnings | | [`report`] |
 //! | the whole method: weld, the stages, un-weld, timings | | [`pipeline`] |
@@ -33,6 +34,7 @@ pub mod report;
 pub mod rows;
 pub mod skeleton;
 pub mod tolerance;
+pub mod transfer;
 pub mod warning;
 pub mod weights;
 

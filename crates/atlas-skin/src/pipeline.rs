@@ -26,6 +26,7 @@ use crate::skeleton::hierarchy::infer_hierarchy;
 use crate::skeleton::placement::{check_placement, PlacementError};
 use crate::warning::{Warning, WarningTopic};
 use crate::weights::blend::Blend;
+use crate::weights::pieces_by_transfer::{transfer_to_loose_pieces, LoosePieces};
 use crate::weights::rigid::{bind_rigidly, Binding};
 use crate::weights::{compute_weights, SurfaceWeights, WeightCounts, WeightsError};
 use atlas_skin_runtime::{RuntimeError, Skeleton, VertexWeights};
@@ -76,6 +77,9 @@ pub struct SkinParams {
     pub blend: Blend,
     /// Blended weights, or one joint per vertex ([`crate::weights::rigid`]).
     pub binding: Binding,
+    /// §5: how the pieces that hold no bone are weighted
+    /// ([`crate::weights::pieces_by_transfer`]).
+    pub loose_pieces: LoosePieces,
     /// Influences kept per stored vertex, the largest, renormalised (at least 1).
     pub max_influences: usize,
     /// §4–5: rules of the weights stage switched off, to measure each alone (a developer
@@ -90,6 +94,7 @@ impl Default for SkinParams {
             overlap: OverlapParams::default(),
             blend: Blend::default(),
             binding: Binding::default(),
+            loose_pieces: LoosePieces::default(),
             max_influences: 4,
             weights_rules_off: RulesOff::default(),
         }
@@ -280,13 +285,24 @@ pub fn skin(
     done(&mut timings);
 
     let done = run(Stage::Weights);
-    let (mut surface_weights, weight_counts) = compute_weights(
+    let (mut surface_weights, mut weight_counts) = compute_weights(
         &decomposition,
         &skeleton,
         &overlaps,
         params.blend,
         &params.weights_rules_off,
     )?;
+    if params.loose_pieces == LoosePieces::Transfer {
+        match transfer_to_loose_pieces(
+            &decomposition,
+            &weight_counts.pieces,
+            skeleton.len(),
+            &mut surface_weights,
+        ) {
+            Ok(transferred) => weight_counts.transferred = transferred,
+            Err(warning) => warnings.push(Warning::new(WarningTopic::Weights, warning)),
+        }
+    }
     if params.binding == Binding::Rigid {
         surface_weights = bind_rigidly(&surface_weights, &skeleton);
     }

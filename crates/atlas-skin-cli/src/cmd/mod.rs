@@ -9,3 +9,4 @@ pub mod inspect;
 pub mod pose;
 pub mod report;
 pub mod skin;
+pub mod transfer;

@@ -174,7 +174,7 @@ pub fn run(args: Args) -> Result<()> {
 }
 
 /// A spinner with the current stage on stderr, hidden when stderr is not a terminal.
-fn progress_bar() -> ProgressBar {
+pub(crate) fn progress_bar() -> ProgressBar {
     if !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
     }

@@ -103,7 +103,10 @@ fn read_u32(bytes: &[u8], at: usize) -> Option<u32> {
 
 /// The byte ranges of a GLB file's JSON chunk and of its BIN chunk (if any), checking the
 /// header and every chunk length against the file size.
-fn split_glb(path: &Path, bytes: &[u8]) -> Result<(Range<usize>, Option<Range<usize>>), IoError> {
+pub(crate) fn split_glb(
+    path: &Path,
+    bytes: &[u8],
+) -> Result<(Range<usize>, Option<Range<usize>>), IoError> {
     let error = |message: String| IoError::invalid(path, message);
     if bytes.len() < GLB_HEADER_BYTES {
         return Err(error(format!(

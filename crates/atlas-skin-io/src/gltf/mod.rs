@@ -6,6 +6,7 @@
 //! (materials, textures, animations, names, extras, extensions).
 
 mod accessor;
+mod added_meshes;
 mod animation;
 mod bindings;
 mod budget;
@@ -22,6 +23,7 @@ mod rewrite;
 mod view_span;
 mod write;
 
+pub use added_meshes::{with_added_meshes, AddedMesh};
 pub use bindings::Binding;
 pub use budget::{DECODED_FLOOR_BYTES, DECODED_PER_INPUT_BYTE, MAX_DECODED_BYTES};
 pub use container::{ImageBytes, MAX_LOADED_BYTES};

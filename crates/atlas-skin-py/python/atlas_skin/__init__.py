@@ -10,6 +10,8 @@ Thibert, INRIA RR-6406, 2008, with the extensions of the atlas-skin project).
   skinning.
 - ``skin_file``: the job of ``atlas-skin skin`` (a character file to a skinned glb).
 - ``batch``: the job of ``atlas-skin batch`` (many files, several at a time, a log).
+- ``transfer``: a skinned mesh's weights carried onto other meshes (clothes, hair, props),
+  on numpy arrays; ``transfer_file``: the job of ``atlas-skin transfer``.
 
 Bad input raises ``ValueError`` (``FileNotFoundError`` for a missing file) with the
 message the command line prints. With ``fail_on`` (the quality gate), a rejected character
@@ -31,6 +33,8 @@ from ._atlas_skin import (
     demo,
     load,
     skin_file,
+    transfer,
+    transfer_file,
 )
 
 
@@ -64,4 +68,6 @@ __all__ = [
     "demo",
     "load",
     "skin_file",
+    "transfer",
+    "transfer_file",
 ]

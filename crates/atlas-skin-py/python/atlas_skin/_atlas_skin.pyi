@@ -252,3 +252,63 @@ def batch(
     (a pattern matching nothing, a folder without character files, two inputs with one
     name, an output over an input).
     """
+
+def transfer(
+    source_vertices: npt.ArrayLike,
+    source_triangles: npt.ArrayLike,
+    source_indices: npt.ArrayLike,
+    source_weights: npt.ArrayLike,
+    target_vertices: npt.ArrayLike,
+    target_triangles: npt.ArrayLike,
+    *,
+    joint_count: Optional[int] = None,
+    max_influences: int = 4,
+    distance: Optional[float] = None,
+    angle_degrees: Optional[float] = None,
+    flipped_normals: Optional[bool] = None,
+    smooth_iterations: Optional[int] = None,
+    smooth_alpha: Optional[float] = None,
+) -> Tuple[npt.NDArray[np.uint32], npt.NDArray[np.float32], Dict[str, Any]]:
+    """Carries the source's weights onto the target (Abdrashitov et al. 2023: closest
+    point matching within ``distance`` times the source's bounding-box diagonal (0.05) and
+    ``angle_degrees`` between normals (30; flipped normals accepted unless
+    ``flipped_normals=False``), the other vertices inpainted by the smoothest completion,
+    ``smooth_iterations`` rounds (10) of strength ``smooth_alpha`` (0.2) near the seam).
+
+    ``source_vertices`` ``(V, 3)``, ``source_triangles`` ``(F, 3)``, ``source_indices`` and
+    ``source_weights`` ``(V, K)`` (as ``load`` returns them), ``target_vertices``
+    ``(T, 3)`` in the source's rest space, ``target_triangles`` ``(G, 3)``;
+    ``joint_count``: the skeleton's joints (default: the largest index + 1).
+
+    Returns ``(T, max_influences)`` uint32 indices and float32 weights (the largest,
+    summing to 1, padded with joint 0 and weight 0) and a dict: ``counts`` (matched,
+    inpainted, nearest, ...), ``pieces`` (each connected piece of the target),
+    ``distance`` (the matching distance in the source's units), ``vertex_sources`` (per
+    target vertex: "matched", "inpainted" or "nearest"). Raises ``ValueError`` for bad
+    arrays or settings, a source without weights, a target nowhere near the source or of
+    another size.
+    """
+
+def transfer_file(
+    source: StrPath,
+    targets: Sequence[StrPath],
+    output: StrPath,
+    *,
+    meshes: Optional[Sequence[str]] = None,
+    report: Optional[StrPath] = None,
+    html: Optional[StrPath] = None,
+    skeleton: Optional[StrPath] = None,
+    weights: Optional[StrPath] = None,
+    max_influences: int = 4,
+    distance: Optional[float] = None,
+    angle_degrees: Optional[float] = None,
+    flipped_normals: Optional[bool] = None,
+    smooth_iterations: Optional[int] = None,
+    smooth_alpha: Optional[float] = None,
+) -> Dict[str, Any]:
+    """The job of ``atlas-skin transfer SOURCE TARGET... -o OUTPUT`` (or, with ``meshes``
+    and no targets, ``--meshes``): writes the skinned glb (and the JSON ``report`` and
+    ``html`` report when given), each written to a temporary file and renamed, never over
+    an input. Settings as ``transfer``. Returns the report. Raises ``FileNotFoundError``
+    for a missing input, ``ValueError`` with the command line's message otherwise.
+    """

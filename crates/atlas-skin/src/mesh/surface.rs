@@ -63,6 +63,20 @@ impl SurfaceMesh {
             .sum()
     }
 
+    /// Unit vertex normals n_v = normalize(Σ_{f ∋ v} (b − a) × (c − a)), the area-weighted
+    /// mean of the normals of the faces around v; zero where that sum vanishes (a vertex
+    /// no face uses, or only faces of zero area).
+    pub fn vertex_normals(&self) -> Vec<DVec3> {
+        let mut sums = vec![DVec3::ZERO; self.vertex_count()];
+        for (f, t) in self.triangles.iter().enumerate() {
+            let n = self.scaled_normal(f);
+            for &v in t {
+                sums[v as usize] += n;
+            }
+        }
+        sums.into_iter().map(DVec3::normalize_or_zero).collect()
+    }
+
     /// Area of triangle `f`.
     pub fn triangle_area(&self, f: usize) -> f64 {
         0.5 * self.scaled_normal(f).length()

@@ -63,7 +63,8 @@
 //!    are weighted as a whole by the same rules. The guard does not touch them: its
 //!    correction, vertex by vertex, would tear a piece apart that these rules keep whole
 //!    (a rigid hood whose flared edge lies over the upper arm; docs/measurements.md, "The
-//!    guard against far bones").
+//!    guard against far bones"). A setting weights the pieces that hold no bone instead by
+//!    weight transfer from the pieces that do ([`pieces_by_transfer`]; not the default).
 //!
 //! 7. **Rigid binding.** When the user asks for it ([`rigid::Binding::Rigid`]), each vertex
 //!    then takes one joint with weight 1: the deepest joint whose subtree holds more than
@@ -80,6 +81,7 @@ pub mod chains;
 pub mod guard;
 pub mod ownership;
 pub mod pieces;
+pub mod pieces_by_transfer;
 pub mod related;
 pub mod rigid;
 pub mod siblings;

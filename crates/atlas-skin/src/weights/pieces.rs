@@ -130,6 +130,7 @@ pub fn weight_pieces(
         .map(|vs| PieceWeighting {
             treatment: PieceTreatment::Body,
             vertices: vs.len(),
+            holds_bones: true,
         })
         .collect();
     let unreachable = empty.iter().filter(|&&e| e).count();
@@ -245,6 +246,7 @@ pub fn weight_pieces(
                 });
             } else {
                 pieces[unit.piece].treatment = treatment;
+                pieces[unit.piece].holds_bones = holding;
             }
             for (&v, row) in unit.vertices.iter().zip(unit_rows) {
                 rows[v as usize] = Some(row);

@@ -72,6 +72,9 @@ pub struct WeightCounts {
     pub far_bone_vertices: usize,
     /// Vertices whose sibling blends gave weight to the siblings' common ancestor (step 3b).
     pub sibling_blend_vertices: usize,
+    /// Vertices of the pieces that hold no bone weighted by transfer from the others
+    /// ([`super::pieces_by_transfer`]; 0 under the default contact rule).
+    pub transferred: usize,
 }
 
 /// How a piece was weighted.
@@ -95,6 +98,10 @@ pub struct PieceWeighting {
     #[serde(flatten)]
     pub treatment: PieceTreatment,
     pub vertices: usize,
+    /// A bone runs through it (body pieces, and the pieces of [`super::pieces`] that hold
+    /// bones); false for the pieces that hold none (clothes, hair, props).
+    #[serde(skip)]
+    pub holds_bones: bool,
 }
 
 /// A gap of a body piece (vertices no region with joints reaches, joined by edges) and how
