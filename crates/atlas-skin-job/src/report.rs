@@ -57,12 +57,14 @@ pub struct SkinReport<'a> {
 
 #[derive(Serialize)]
 struct ReportCounts {
+    crowded_vertices: usize,
     duplicate_faces: usize,
     fallback_weighted_vertices: usize,
     far_bone_vertices: usize,
     inside_out_pieces: usize,
     joints: usize,
     max_influences: usize,
+    merged_joints: usize,
     off_carrier_vertices: usize,
     regions: usize,
     sibling_blend_vertices: usize,
@@ -167,11 +169,13 @@ impl<'a> SkinReport<'a> {
         Self {
             binding: skinned.binding.name(),
             counts: ReportCounts {
+                crowded_vertices: weight_counts.crowded_vertices,
                 duplicate_faces: counts.duplicate_faces,
                 fallback_weighted_vertices: counts.unreferenced_stored_vertices,
                 far_bone_vertices: weight_counts.far_bone_vertices,
                 inside_out_pieces: counts.inside_out_pieces,
                 joints: counts.joints,
+                merged_joints: skinned.decomposition.merged_joints.len(),
                 max_influences: skinned.weights.max_influences(),
                 off_carrier_vertices: weight_counts.off_carrier,
                 regions: decomposition.regions.len(),
@@ -548,6 +552,8 @@ mod tests {
                 "max_influences": skinned.weights.max_influences(),
                 "far_bone_vertices": weight_counts.far_bone_vertices,
                 "sibling_blend_vertices": weight_counts.sibling_blend_vertices,
+                "merged_joints": decomposition.merged_joints.len(),
+                "crowded_vertices": weight_counts.crowded_vertices,
                 "off_carrier_vertices": weight_counts.off_carrier,
                 "duplicate_faces": counts.duplicate_faces,
                 "inside_out_pieces": counts.inside_out_pieces,

@@ -12,6 +12,7 @@
 //! space, the joints the input marks as end points) and [`SkinParams`]. Output: [`Skinned`].
 
 use crate::ablation::RulesOff;
+use crate::cuts::merged_joints::merge_warning;
 use crate::decompose::{decompose, DecomposeError, DecomposeParams};
 use crate::decomposition::Decomposition;
 use crate::mesh::duplicate_faces::remove_duplicate_faces;
@@ -24,6 +25,7 @@ use crate::skeleton::bones::{bone_segments, capped_extensions, nearest_bone, EXT
 use crate::skeleton::hierarchy::infer_hierarchy;
 use crate::skeleton::placement::{check_placement, decomposition_warnings, PlacementError};
 use crate::weights::blend::Blend;
+use crate::weights::crowding::crowding_warning;
 use crate::weights::rigid::{bind_rigidly, Binding};
 use crate::weights::{compute_weights, SurfaceWeights, WeightCounts, WeightsError};
 use atlas_skin_runtime::{RuntimeError, Skeleton, VertexWeights};
@@ -252,6 +254,7 @@ pub fn skin(
         ));
     }
     let decomposition = decompose(&welded.mesh, &topology, &skeleton, &params.decompose)?;
+    warnings.extend(merge_warning(&decomposition.merged_joints, &skeleton));
     warnings.extend(decomposition_warnings(
         &decomposition,
         &params.decompose.forbid,
@@ -270,6 +273,7 @@ pub fn skin(
         params.blend,
         &params.weights_rules_off,
     )?;
+    warnings.extend(crowding_warning(weight_counts.crowded_vertices));
     if params.binding == Binding::Rigid {
         surface_weights = bind_rigidly(&surface_weights, &skeleton);
     }
