@@ -2,7 +2,7 @@
 //! fewer joints, so that the cost of every later stage is bounded by the input.
 //!
 //! A joint J that would get a boundary lies at depth r_J in the body (its surface distance,
-//! [`JointFrame::surface_distance`]). Its cut's section has a diameter D of about 2 r_J and
+//! [`super::joint_roles::JointFrame::surface_distance`]). Its cut's section has a diameter D of about 2 r_J and
 //! its overlap band a half-width w = ½ D ≈ r_J on each side (§3.3). Boundaries whose joints
 //! are closer together than a small part of r_J along a chain stack their bands: a vertex
 //! lies in 2 w / s bands for joints s apart, and the plane search of each joint scans the

@@ -3,7 +3,7 @@
 //! surface whatever the skeleton (issue 45).
 //!
 //! A soft boundary's child side floods its region along the surface past its plane, as far
-//! as its own bones are the nearer ([`super::soft_sides`]). Where the skeleton does not
+//! as its own bones are the nearer ([`mod@super::soft_sides`]). Where the skeleton does not
 //! follow the mesh's shape (a chain coiled in a capsule, a tree of joints spread through
 //! one blob: every section of every joint encloses other bones, so every joint is soft),
 //! hundreds of sides reach every vertex: on a 100,000-vertex capsule with a chain of 2,000
@@ -11,7 +11,7 @@
 //! of them at a vertex in the sibling blends. No vertex of the 113 real characters compared
 //! in docs/measurements.md ("Many joints") is crowded: their weights are unchanged.
 //!
-//! The rule: the sides are found deepest joint first ([`super::soft_sides`]), in batches of
+//! The rule: the sides are found deepest joint first ([`mod@super::soft_sides`]), in batches of
 //! [`BATCH`] in parallel. A side does not enter a vertex that [`MOST_SOFT_SIDES`] sides
 //! found before its batch already reach (it is not in play for that side, as a vertex
 //! outside its region is not); after each batch, the sides keep their vertices in batch

@@ -236,7 +236,7 @@ impl<'a> FarJoints<'a> {
 /// every segment cost vertices × bones (10,000 joints folded up and down a capsule of
 /// 100,000 vertices: 45 s of CPU, issue 45). The distances are
 /// [`point_segment_distance`]'s, the scan's, so the result is the scan's
-/// ([`nearest_seen_bone_by_scan`], compared in a test).
+/// (`nearest_seen_bone_by_scan`, compared in a test).
 fn nearest_seen_bone(
     surface: &crate::mesh::SurfaceMesh,
     spheres: &FaceSpheres,
