@@ -379,6 +379,9 @@ mod tests {
         assert!(!far.any_far(on_bone_1, [1]));
     }
 
+    /// A bone segment: its joint and ends.
+    type Segment = (u32, DVec3, DVec3);
+
     /// The nearest seen bone by the tree is the scan's at every vertex of cesiumman and
     /// makehuman's body, of a tube around a chain folded up and down it (bones beside one
     /// another, many at one distance) and at points off the surfaces.
@@ -388,13 +391,13 @@ mod tests {
             .map(|k| DVec3::new(0.05 * (k / 10) as f64, 0.1 * (k % 10) as f64, 0.0))
             .collect();
         let (tube, _) = capsule_chain(&[DVec3::ZERO, DVec3::Y], &[], 0.3, 12, 20);
-        let mut cases: Vec<(String, SurfaceMesh, Vec<(u32, DVec3, DVec3)>)> =
+        let mut cases: Vec<(String, SurfaceMesh, Vec<Segment>)> =
             crate::fixtures::corpus::welded_humans()
                 .into_iter()
                 .map(|(file, mesh, skeleton)| (file.to_string(), mesh, bone_segments(&skeleton)))
                 .collect();
         // Straight passes up and down, and the same bone repeated (equal distances).
-        let mut passes: Vec<(u32, DVec3, DVec3)> = folded
+        let mut passes: Vec<Segment> = folded
             .windows(2)
             .enumerate()
             .map(|(k, w)| (k as u32, w[0], w[1]))
