@@ -70,13 +70,7 @@ pub fn guard_far_bones(
         return 0;
     }
     let spheres = decomposition.surface_spheres();
-    let segment_tree = BoneTree::new(
-        segments
-            .iter()
-            .enumerate()
-            .map(|(i, &(_, a, b))| (i as u32, a, b)),
-        Split::Space,
-    );
+    let segment_tree = segment_tree(&segments);
     let mut changed = 0;
     let replaced: Rows<(u32, f64)> = Rows::par_build(
         suspects.len(),
@@ -224,6 +218,12 @@ impl<'a> FarJoints<'a> {
             .into_iter()
             .any(|j| self.joint_distance(p, j) > limit)
     }
+}
+
+/// The tree of `segments` that [`nearest_seen_bone`] reads: each keyed by its index.
+fn segment_tree(segments: &[(u32, DVec3, DVec3)]) -> BoneTree {
+    let keyed = segments.iter().enumerate();
+    BoneTree::new(keyed.map(|(i, &(_, a, b))| (i as u32, a, b)), Split::Space)
 }
 
 /// The joint and distance of the nearest bone segment whose nearest point to `p` is seen
@@ -406,13 +406,7 @@ mod tests {
         cases.push(("folded".into(), tube, passes));
         for (name, mesh, segments) in cases {
             let spheres = FaceSpheres::new(&mesh);
-            let tree = BoneTree::new(
-                segments
-                    .iter()
-                    .enumerate()
-                    .map(|(i, &(_, a, b))| (i as u32, a, b)),
-                Split::Space,
-            );
+            let tree = segment_tree(&segments);
             let offsets = [DVec3::ZERO, DVec3::new(0.3, -0.2, 0.1), DVec3::splat(-2.0)];
             for (v, &p) in mesh.positions.iter().enumerate() {
                 for offset in offsets {
