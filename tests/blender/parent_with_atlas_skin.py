@@ -183,13 +183,18 @@ def check_options(path):
 
 
 def check_tails(path):
-    """Bone tails (on by default) make leaf bones segments, which a glTF file has not."""
+    """Bone tails (on by default) make leaf bones segments, which a glTF file has not; both
+    ways the weights are valid. Since 37dbda8 a leaf's tail moves only its bone's segment
+    (read by the far-bone guard and the pieces), which changes no weight of the knight."""
     armature, meshes = import_character(path)
     strip_weights(meshes)
     assert run_operator(armature, meshes) == {"FINISHED"}
     check_groups("with bone tails", meshes, deforming_names(armature))
+    armature, meshes = import_character(path)
+    strip_weights(meshes)
+    assert run_operator(armature, meshes, use_tails=False) == {"FINISHED"}
+    check_groups("without bone tails", meshes, deforming_names(armature))
     differs = np.abs(weights_with(path) - weights_with(path, use_tails=False)).max()
-    assert differs > 0.01, "the bone tails change nothing"
     print(f"bone tails: valid weights, differ from the heads alone by up to {differs:.2f}")
 
 

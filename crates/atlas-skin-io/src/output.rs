@@ -1,4 +1,4 @@
-//! Writing output files safely: one policy for every command (README, "Security").
+//! Writing output files safely: one policy for every command (docs/security.md).
 //!
 //! - No output may be an input of the same command, nor another of its outputs (paths
 //!   compared after resolving links, `..` and `.`).

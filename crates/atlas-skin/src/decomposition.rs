@@ -3,7 +3,6 @@
 
 use crate::cuts::merged_joints::MergedJoint;
 use crate::mesh::{FaceSpheres, SurfaceMesh, Topology};
-use crate::regions::shared_sides::SharedSide;
 use glam::DVec3;
 use serde::Serialize;
 use std::sync::OnceLock;
@@ -43,6 +42,15 @@ impl Decomposition {
         self.surface_spheres
             .get_or_init(|| FaceSpheres::new(&self.surface))
     }
+}
+
+/// A region that was divided ([`crate::regions::shared_sides`]): the head joint of each
+/// family of cuts that shared it (in the skeleton's topological order) and the region of each family's part (the first keeps
+/// the divided region).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SharedSide {
+    pub joints: Vec<u32>,
+    pub regions: Vec<u32>,
 }
 
 /// A connected part of the split surface.

@@ -1,7 +1,10 @@
 //! What the decomposition reports: the JSON of `atlas-skin skin --report` (under its
-//! `decomposition` key) and the debug view (vertex colours by region, cut curves as lines).
+//! `decomposition` key), the debug view (vertex colours by region, cut curves as lines) and
+//! the warnings about what it made of the skeleton.
 
-use crate::decomposition::{BoundaryKind, Decomposition, JointStatus};
+use crate::cuts::joint_roles::HELPER_REASON;
+use crate::decomposition::{BoundaryKind, Decomposition, JointDecision, JointStatus};
+use crate::skeleton::placement::listed;
 use serde::Serialize;
 
 /// The decomposition as the report shows it.
@@ -168,4 +171,62 @@ fn region_color(r: u32) -> [f32; 4] {
     };
     let m = v - c;
     [r + m, g + m, b + m, 1.0]
+}
+
+/// Warnings about what the decomposition made of the skeleton: most joints outside the
+/// surface owning nothing (`forbidden`: the joints the user or the input forbade, which
+/// are not counted), or no boundary at all on a skeleton of several joints.
+pub fn decomposition_warnings(decomposition: &Decomposition, forbidden: &[String]) -> Vec<String> {
+    let joints = &decomposition.joints;
+    let mut warnings = Vec::new();
+    let is_helper =
+        |j: &JointDecision| matches!(&j.status, JointStatus::Skipped(r) if r == HELPER_REASON);
+    let helpers: Vec<String> = joints
+        .iter()
+        .filter(|j| is_helper(j))
+        .map(|j| j.name.clone())
+        .collect();
+    if !helpers.is_empty() {
+        warnings.push(format!(
+            "{} joint(s) named as helpers that deform nothing (attachment slots, locators, IK \
+             targets) move no skin; `--force JOINT` weights one: {}",
+            helpers.len(),
+            listed(helpers.into_iter())
+        ));
+    }
+    let outside: Vec<String> = joints
+        .iter()
+        .filter(|j| !j.owns_skin && !forbidden.contains(&j.name) && !is_helper(j))
+        .map(|j| j.name.clone())
+        .collect();
+    if joints.len() >= 2 && 2 * outside.len() >= joints.len() {
+        warnings.push(format!(
+            "{} of {} joints lie outside the surface and own none of it: the skeleton may not \
+             sit in the body (moved, flipped or scaled against the mesh?): {}",
+            outside.len(),
+            joints.len(),
+            listed(outside.into_iter())
+        ));
+    }
+    for shared in &decomposition.shared_sides {
+        warnings.push(format!(
+            "the surface joins the sides of the cuts of {} (a higher genus: a hand fused to \
+             the body, a part welded across a joint): their region was divided among them by \
+             the bones behind each face",
+            listed(
+                shared
+                    .joints
+                    .iter()
+                    .map(|&j| joints[j as usize].name.clone())
+            )
+        ));
+    }
+    if joints.len() >= 2 && decomposition.boundaries.is_empty() {
+        warnings.push(format!(
+            "no joint got a boundary: the whole mesh is {} region(s), with no transition \
+             between joints (see each joint's reason in the decomposition)",
+            decomposition.regions.len()
+        ));
+    }
+    warnings
 }

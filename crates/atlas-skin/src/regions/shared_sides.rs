@@ -37,6 +37,7 @@
 
 use super::find_edge;
 use crate::cuts::joint_roles::orientation_sign;
+use crate::decomposition::SharedSide;
 use crate::geometry::segment_parameter;
 use crate::mesh::{SurfaceMesh, Topology};
 use crate::rows::Rows;
@@ -50,15 +51,6 @@ pub struct ChildSide<'a> {
     pub joint: u32,
     pub region: u32,
     pub curve: &'a [u32],
-}
-
-/// A region that was divided: the head joint of each family of cuts that shared it (in the
-/// skeleton's topological order) and the region of each family's part (the first keeps
-/// the divided region).
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct SharedSide {
-    pub joints: Vec<u32>,
-    pub regions: Vec<u32>,
 }
 
 const UNASSIGNED: u32 = u32::MAX;

@@ -64,18 +64,18 @@
 //! nearest bones likewise: .0088 / .184 to .0088 / .183, fallback share 2.2% to 0.9%.
 //! Weighting the pieces that hold bones first and letting the others sit on them too:
 //! .0088 / .183 to .0084 / .176 (17 characters better on the mean, 6 worse; KayKit's
-//! helmets and hoods now move with the head piece they sit on). A bone that only pokes
-//! into a piece holding none for half its length is held only when it is the nearest bone
-//! to at least half of the piece's vertices (session 14: a strap across a chest that a
-//! clavicle's bone crosses moved rigidly with the clavicle): deform mean −1.0%, max
-//! −0.9% (7 characters better, 4 worse). A piece that no bone enters holds the bones
-//! around it (session 16: KayKit Mage's hat was carried by the shoulders its brim lies
-//! on): deform mean −1.2%, max −2.0% (7 characters better, 4 worse). A piece around a
-//! free joint holds its bones (session 17): around the root, rignet-val/9826's pedestal
-//! (bent between the feet that stand in it, max .454; its artist binds it to the root):
-//! deform mean −6.5%, max −5.0%, on that one character; around end sites, 12913's wand,
-//! 6789's and 6808's heads around a cap's joint: mean −1.7%, max −0.6% more (3 better, 1 worse
-//! within 1%).
+//! helmets and hoods now move with the head piece they sit on). A bone that only pokes into
+//! a piece holding none for half its length is held only when it is the nearest bone to at
+//! least half of the piece's vertices (2026-12-03, 8b26b8b: a strap across a chest that a
+//! clavicle's bone crosses moved rigidly with the clavicle): deform mean −1.0%, max −0.9%
+//! (7 characters better, 4 worse). A piece that no bone enters holds the bones around it
+//! (2026-12-03, 22c13c7: KayKit Mage's hat was carried by the shoulders its brim lies on):
+//! deform mean −1.2%, max −2.0% (7 characters better, 4 worse). A piece around a free joint
+//! holds its bones (2026-12-03, e3e8b3a): around the root, rignet-val/9826's pedestal (bent
+//! between the feet that stand in it, max .454; its artist binds it to the root): deform
+//! mean −6.5%, max −5.0%, on that one character; around end sites, 12913's wand, 6789's and
+//! 6808's heads around a cap's joint: mean −1.7%, max −0.6% more (3 better, 1 worse within
+//! 1%).
 //!
 //! **Contact.** A piece that holds no bone is carried by the body where it touches it.
 //! With d_S(p) as above and s the piece's bounding-box diagonal, its contact zone is

@@ -42,7 +42,7 @@
 //! choice beneath it.
 //!
 //! Measured on the characters of the benchmark that their artists bound rigidly, against
-//! the heaviest joint of the final row and of the row before the sibling blends (step 3c):
+//! the heaviest joint of the final row and of the row before the sibling blends (step 3b):
 //! docs/measurements.md, "Rigid bindings".
 
 use super::siblings::depths;
