@@ -21,8 +21,6 @@
 //! most [`MOST_SOFT_SIDES`] + [`BATCH`] − 1 sides computed, and keeps
 //! [`MOST_SOFT_SIDES`].
 
-use super::soft_sides::SoftSide;
-
 /// The most soft joints that act at one vertex: far more than a real rig's soft joints
 /// overlap at one point (none of the characters measured reaches it).
 pub const MOST_SOFT_SIDES: u16 = 16;
@@ -59,28 +57,22 @@ impl Crowding {
         self.counts[v] >= MOST_SOFT_SIDES
     }
 
-    /// Counts the vertices of one batch of `sides` (in batch order), dropping those of a
-    /// side where the vertex is full; `refused`: the vertices the batch's floods did not
-    /// enter because they were full.
-    pub fn admit<'a>(
-        &mut self,
-        sides: impl Iterator<Item = &'a mut SoftSide>,
-        refused: impl Iterator<Item = u32>,
-    ) {
-        for v in refused {
-            self.crowded[v as usize] = true;
+    /// Marks `v` crowded: a flood did not enter it because it was full.
+    pub fn refuse(&mut self, v: u32) {
+        self.crowded[v as usize] = true;
+    }
+
+    /// Counts one more side at `v` when it has room and returns true; otherwise marks it
+    /// crowded and returns false (the side drops it). The sides of a batch are admitted in
+    /// batch order.
+    pub fn admit(&mut self, v: u32) -> bool {
+        let v = v as usize;
+        if self.counts[v] >= MOST_SOFT_SIDES {
+            self.crowded[v] = true;
+            return false;
         }
-        for side in sides {
-            side.retain_reached(|v| {
-                let v = v as usize;
-                if self.counts[v] >= MOST_SOFT_SIDES {
-                    self.crowded[v] = true;
-                    return false;
-                }
-                self.counts[v] += 1;
-                true
-            });
-        }
+        self.counts[v] += 1;
+        true
     }
 
     /// The vertices where a side was left out.

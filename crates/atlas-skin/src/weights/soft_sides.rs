@@ -189,8 +189,12 @@ pub fn soft_sides(
                 .into_iter()
                 .filter_map(|(i, s, refused)| s.map(|s| (i, s, refused)))
                 .collect();
-            let refused: Vec<u32> = found.iter().flat_map(|f| f.2.iter().copied()).collect();
-            crowding.admit(found.iter_mut().map(|f| &mut f.1), refused.into_iter());
+            for &v in found.iter().flat_map(|f| &f.2) {
+                crowding.refuse(v);
+            }
+            for (_, side, _) in &mut found {
+                side.retain_reached(|v| crowding.admit(v));
+            }
             sides.extend(found.into_iter().map(|(i, s, _)| (i, s)));
         }
         for (_, s) in &sides[level_start..] {
