@@ -76,12 +76,14 @@ struct ReportQuality<'a> {
 
 #[derive(Serialize)]
 struct ReportCounts {
+    crowded_vertices: usize,
     duplicate_faces: usize,
     fallback_weighted_vertices: usize,
     far_bone_vertices: usize,
     inside_out_pieces: usize,
     joints: usize,
     max_influences: usize,
+    merged_joints: usize,
     off_carrier_vertices: usize,
     regions: usize,
     sibling_blend_vertices: usize,
@@ -187,11 +189,13 @@ impl<'a> SkinReport<'a> {
         Self {
             binding: skinned.binding.name(),
             counts: ReportCounts {
+                crowded_vertices: weight_counts.crowded_vertices,
                 duplicate_faces: counts.duplicate_faces,
                 fallback_weighted_vertices: counts.unreferenced_stored_vertices,
                 far_bone_vertices: weight_counts.far_bone_vertices,
                 inside_out_pieces: counts.inside_out_pieces,
                 joints: counts.joints,
+                merged_joints: skinned.decomposition.merged_joints.len(),
                 max_influences: skinned.weights.max_influences(),
                 off_carrier_vertices: weight_counts.off_carrier,
                 regions: decomposition.regions.len(),
@@ -553,6 +557,8 @@ mod tests {
                 "max_influences": skinned.weights.max_influences(),
                 "far_bone_vertices": weight_counts.far_bone_vertices,
                 "sibling_blend_vertices": weight_counts.sibling_blend_vertices,
+                "merged_joints": decomposition.merged_joints.len(),
+                "crowded_vertices": weight_counts.crowded_vertices,
                 "off_carrier_vertices": weight_counts.off_carrier,
                 "transferred_vertices": weight_counts.transferred,
                 "duplicate_faces": counts.duplicate_faces,

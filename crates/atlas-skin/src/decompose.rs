@@ -13,6 +13,7 @@
 
 use crate::cuts::conflicts::{place_cuts, Placement};
 use crate::cuts::joint_roles::{plan_joints, JointFrame, JointPlan};
+use crate::cuts::merged_joints::merge_dense_joints;
 use crate::cuts::plane_search::{find_cut_candidates, CutCandidate, CutSearch, CutSurface};
 use crate::cuts::plane_section::{diameter, vertex_snap_distances, ScratchPool};
 use crate::cuts::split::split_along_curves;
@@ -51,7 +52,7 @@ pub fn decompose(
     let vertex_snap = vertex_snap_distances(mesh, topology, params.snap_fraction);
     let bones = BoneIndex::new(joint_pairs(skeleton, &positions), &positions);
     let children = skeleton.children();
-    let plans = plan_joints(
+    let mut plans = plan_joints(
         mesh,
         &topology.vertex_component,
         &spheres,
@@ -61,6 +62,7 @@ pub fn decompose(
         &overrides,
         params,
     );
+    let merged_joints = merge_dense_joints(skeleton, &positions, &overrides, &mut plans);
     let cut_surface = CutSurface {
         mesh,
         topology,
@@ -191,6 +193,7 @@ pub fn decompose(
         boundaries,
         joints,
         shared_sides,
+        merged_joints,
         surface_spheres,
     })
 }

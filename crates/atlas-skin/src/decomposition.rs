@@ -1,6 +1,7 @@
 //! The result of the decomposition stages (§3.1 cuts, §3.2 regions): what the weights stage
 //! (§3.3–§5) reads. Plain data; [`crate::decompose()`] builds it.
 
+use crate::cuts::merged_joints::MergedJoint;
 use crate::mesh::{FaceSpheres, SurfaceMesh, Topology};
 use glam::DVec3;
 use serde::Serialize;
@@ -26,6 +27,9 @@ pub struct Decomposition {
     /// Regions that were the child side of the cuts of unrelated joints (a hand fused to
     /// the hip) and were divided among them ([`crate::regions::shared_sides`]).
     pub shared_sides: Vec<SharedSide>,
+    /// Joints merged for cutting into a kept ancestor, too close to it for a boundary of
+    /// their own ([`crate::cuts::merged_joints`]), parents first.
+    pub merged_joints: Vec<MergedJoint>,
     /// The face index of `surface`, built by the first [`Decomposition::surface_spheres`]
     /// (the holding regions of soft joints and the guard against far bones share it);
     /// empty (`OnceLock::new()`) when the decomposition is made.

@@ -12,6 +12,7 @@
 //! space, the joints the input marks as end points) and [`SkinParams`]. Output: [`Skinned`].
 
 use crate::ablation::RulesOff;
+use crate::cuts::merged_joints::merge_warning;
 use crate::decompose::{decompose, DecomposeError, DecomposeParams};
 use crate::decomposition::Decomposition;
 use crate::mesh::duplicate_faces::remove_duplicate_faces;
@@ -26,6 +27,7 @@ use crate::skeleton::hierarchy::infer_hierarchy;
 use crate::skeleton::placement::{check_placement, PlacementError};
 use crate::warning::{Warning, WarningTopic};
 use crate::weights::blend::Blend;
+use crate::weights::crowding::crowding_warning;
 use crate::weights::pieces_by_transfer::{transfer_to_loose_pieces, LoosePieces};
 use crate::weights::rigid::{bind_rigidly, Binding};
 use crate::weights::{compute_weights, SurfaceWeights, WeightCounts, WeightsError};
@@ -274,6 +276,7 @@ pub fn skin(
         ));
     }
     let decomposition = decompose(&welded.mesh, &topology, &skeleton, &params.decompose)?;
+    warnings.extend(merge_warning(&decomposition.merged_joints, &skeleton));
     warnings.extend(decomposition_warnings(
         &decomposition,
         &params.decompose.forbid,
@@ -292,6 +295,7 @@ pub fn skin(
         params.blend,
         &params.weights_rules_off,
     )?;
+    warnings.extend(crowding_warning(weight_counts.crowded_vertices));
     if params.loose_pieces == LoosePieces::Transfer {
         match transfer_to_loose_pieces(
             &decomposition,

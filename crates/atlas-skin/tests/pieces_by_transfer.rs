@@ -154,7 +154,10 @@ fn a_prop_far_from_the_body_keeps_the_contact_rules_weights_with_a_warning() {
         .iter()
         .find(|w| w.message.contains("keep the contact rule's weights"))
         .unwrap_or_else(|| panic!("a warning: {:?}", transfer.warnings));
-    assert!(warning.message.contains("no vertex lies within"), "{warning}");
+    assert!(
+        warning.message.contains("no vertex lies within"),
+        "{warning}"
+    );
     for v in 0..demo.positions.len() {
         let (x, y): (Vec<_>, Vec<_>) = (
             contact.weights.row(v).collect(),

@@ -177,6 +177,7 @@ fn decompose_by_hand(
         boundaries,
         joints,
         shared_sides: Vec::new(),
+        merged_joints: Vec::new(),
         surface_spheres: Default::default(),
     }
 }

@@ -23,10 +23,11 @@ use crate::decomposition::Decomposition;
 use crate::geometry::{point_segment_distance, segment_parameter};
 use crate::mesh::FaceSpheres;
 use crate::rows::{Rows, PAR_CHUNK};
-use crate::skeleton::bone_tree::BoneTree;
+use crate::skeleton::bone_tree::{BoneTree, Split};
 use crate::skeleton::bones::{bone_segments, JointBones};
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
+use std::ops::ControlFlow;
 
 /// R: a joint whose bones are this many times farther than the nearest bone reached
 /// through the body is far (chosen on the benchmark, docs/measurements.md).
@@ -69,6 +70,7 @@ pub fn guard_far_bones(
         return 0;
     }
     let spheres = decomposition.surface_spheres();
+    let segment_tree = segment_tree(&segments);
     let mut changed = 0;
     let replaced: Rows<(u32, f64)> = Rows::par_build(
         suspects.len(),
@@ -76,7 +78,9 @@ pub fn guard_far_bones(
         |k, _: &mut (), out: &mut Vec<(u32, f64)>| {
             let v = suspects[k];
             let p = surface.positions[v];
-            let Some((near_joint, near)) = nearest_seen_bone(surface, spheres, &segments, p) else {
+            let Some((near_joint, near)) =
+                nearest_seen_bone(surface, spheres, &segments, &segment_tree, p)
+            else {
                 out.extend(weights.row(v));
                 return;
             };
@@ -216,10 +220,49 @@ impl<'a> FarJoints<'a> {
     }
 }
 
+/// The tree of `segments` that [`nearest_seen_bone`] reads: each keyed by its index.
+fn segment_tree(segments: &[(u32, DVec3, DVec3)]) -> BoneTree {
+    let keyed = segments.iter().enumerate();
+    BoneTree::new(keyed.map(|(i, &(_, a, b))| (i as u32, a, b)), Split::Space)
+}
+
 /// The joint and distance of the nearest bone segment whose nearest point to `p` is seen
 /// from `p` through the body (no face hit before it), among the [`SIGHT_TRIES`] nearest;
-/// the nearest of all when none of them is seen (a vertex on a thin shell).
+/// the nearest of all when none of them is seen (a vertex on a thin shell). Segments at one
+/// distance are taken in their order in `segments`.
+///
+/// The nearest come from `tree` (the segments keyed by their index), nearest first, with
+/// every segment as near as the last of them: a few descents per vertex where a scan of
+/// every segment cost vertices × bones (10,000 joints folded up and down a capsule of
+/// 100,000 vertices: 45 s of CPU, issue 45). The distances are
+/// [`point_segment_distance`]'s, the scan's, so the result is the scan's
+/// (`nearest_seen_bone_by_scan`, compared in a test).
 fn nearest_seen_bone(
+    surface: &crate::mesh::SurfaceMesh,
+    spheres: &FaceSpheres,
+    segments: &[(u32, DVec3, DVec3)],
+    tree: &BoneTree,
+    p: DVec3,
+) -> Option<(u32, f64)> {
+    let mut nearest: Vec<(f64, u32)> = Vec::with_capacity(SIGHT_TRIES);
+    let _ = tree.visit_nearest_first(p, f64::INFINITY, |i, d| {
+        if nearest.len() >= SIGHT_TRIES && nearest.last().is_some_and(|&(last, _)| d > last) {
+            return ControlFlow::Break(());
+        }
+        nearest.push((d, i));
+        ControlFlow::Continue(())
+    });
+    nearest.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+    let by_distance = nearest.into_iter().map(|(d, i)| {
+        let (j, a, b) = segments[i as usize];
+        (d, j, a + (b - a) * segment_parameter(p, a, b))
+    });
+    first_seen(surface, spheres, by_distance, p)
+}
+
+/// The reference of [`nearest_seen_bone`]: every segment's distance, sorted.
+#[cfg(test)]
+fn nearest_seen_bone_by_scan(
     surface: &crate::mesh::SurfaceMesh,
     spheres: &FaceSpheres,
     segments: &[(u32, DVec3, DVec3)],
@@ -233,9 +276,24 @@ fn nearest_seen_bone(
         })
         .collect();
     by_distance.sort_by(|x, y| x.0.total_cmp(&y.0));
-    let first = by_distance.first().map(|&(d, j, _)| (j, d))?;
+    first_seen(surface, spheres, by_distance.into_iter(), p)
+}
+
+/// Of the (distance, joint, nearest point) `by_distance`, nearest first, the first of the
+/// [`SIGHT_TRIES`] nearest seen from `p`, else the nearest.
+fn first_seen(
+    surface: &crate::mesh::SurfaceMesh,
+    spheres: &FaceSpheres,
+    mut by_distance: impl Iterator<Item = (f64, u32, DVec3)>,
+    p: DVec3,
+) -> Option<(u32, f64)> {
+    let (d, j, q) = by_distance.next()?;
+    let first = (j, d);
     let step = 1e-6 * surface.diagonal();
-    for &(d, j, q) in by_distance.iter().take(SIGHT_TRIES) {
+    for (d, j, q) in std::iter::once((d, j, q))
+        .chain(by_distance)
+        .take(SIGHT_TRIES)
+    {
         if d <= step {
             return Some((j, d));
         }
@@ -253,7 +311,7 @@ mod tests {
     use super::*;
     use crate::decompose::{decompose, DecomposeParams};
     use crate::fixtures::shapes::capsule_chain;
-    use crate::mesh::Topology;
+    use crate::mesh::{SurfaceMesh, Topology};
     use crate::skeleton::bones::nearest_bone;
 
     /// The far-joint test with its bounds against every distance by the trees: every vertex
@@ -319,6 +377,48 @@ mod tests {
         assert_eq!(owning.joint_distance(on_bone_1, 1), f64::INFINITY);
         assert!(owning.any_far(on_bone_1, [1]));
         assert!(!far.any_far(on_bone_1, [1]));
+    }
+
+    /// A bone segment: its joint and ends.
+    type Segment = (u32, DVec3, DVec3);
+
+    /// The nearest seen bone by the tree is the scan's at every vertex of cesiumman and
+    /// makehuman's body, of a tube around a chain folded up and down it (bones beside one
+    /// another, many at one distance) and at points off the surfaces.
+    #[test]
+    fn nearest_seen_bones_by_the_tree_are_the_scans() {
+        let folded: Vec<DVec3> = (0..40)
+            .map(|k| DVec3::new(0.05 * (k / 10) as f64, 0.1 * (k % 10) as f64, 0.0))
+            .collect();
+        let (tube, _) = capsule_chain(&[DVec3::ZERO, DVec3::Y], &[], 0.3, 12, 20);
+        let mut cases: Vec<(String, SurfaceMesh, Vec<Segment>)> =
+            crate::fixtures::corpus::welded_humans()
+                .into_iter()
+                .map(|(file, mesh, skeleton)| (file.to_string(), mesh, bone_segments(&skeleton)))
+                .collect();
+        // Straight passes up and down, and the same bone repeated (equal distances).
+        let mut passes: Vec<Segment> = folded
+            .windows(2)
+            .enumerate()
+            .map(|(k, w)| (k as u32, w[0], w[1]))
+            .collect();
+        passes.extend((0..12).map(|k| (100 + k, DVec3::ZERO, DVec3::Y)));
+        cases.push(("folded".into(), tube, passes));
+        for (name, mesh, segments) in cases {
+            let spheres = FaceSpheres::new(&mesh);
+            let tree = segment_tree(&segments);
+            let offsets = [DVec3::ZERO, DVec3::new(0.3, -0.2, 0.1), DVec3::splat(-2.0)];
+            for (v, &p) in mesh.positions.iter().enumerate() {
+                for offset in offsets {
+                    let q = p + offset;
+                    assert_eq!(
+                        nearest_seen_bone(&mesh, &spheres, &segments, &tree, q),
+                        nearest_seen_bone_by_scan(&mesh, &spheres, &segments, q),
+                        "{name}: vertex {v} + {offset}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]

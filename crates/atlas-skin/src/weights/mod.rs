@@ -78,6 +78,7 @@
 pub mod blend;
 pub mod carriers;
 pub mod chains;
+pub mod crowding;
 pub mod guard;
 pub mod ownership;
 pub mod pieces;
@@ -144,6 +145,7 @@ pub fn compute_weights(
     let RegionWeights {
         mut weights,
         inactive_soft_joints,
+        crowded_vertices,
     } = region_weights(decomposition, skeleton, overlaps, blend, rules_off)?;
     let owns_skin: Vec<bool> = decomposition.joints.iter().map(|d| d.owns_skin).collect();
     let joint_bones = JointBones::new(&bone_segments(skeleton));
@@ -167,6 +169,7 @@ pub fn compute_weights(
     counts.far_bone_vertices = far_bone_vertices;
     counts.sibling_blend_vertices = sibling_blend_vertices;
     counts.inactive_soft_joints = inactive_soft_joints;
+    counts.crowded_vertices = crowded_vertices;
     Ok((weights, counts))
 }
 
@@ -176,6 +179,9 @@ pub struct RegionWeights {
     pub weights: SurfaceWeights,
     /// Joints whose soft boundary is inactive (no cross-section near the joint).
     pub inactive_soft_joints: Vec<u32>,
+    /// Vertices that more soft sides would have reached than act at one
+    /// ([`crowding`]).
+    pub crowded_vertices: usize,
 }
 
 /// Steps 1–3 alone (module documentation), with the arguments of [`compute_weights`].
@@ -190,7 +196,8 @@ pub fn region_weights(
     let vertex_count = decomposition.surface.vertex_count();
     let bands = vertex_bands(&overlaps.bands, vertex_count);
     let related = related_regions(decomposition, overlaps, &bands);
-    let softs = soft_sides(decomposition, skeleton, overlaps, &related, rules_off);
+    let (softs, crowded_vertices) =
+        soft_sides(decomposition, skeleton, overlaps, &related, rules_off);
     let mut has_soft_side = vec![false; skeleton.len()];
     for s in &softs {
         has_soft_side[s.joint as usize] = true;
@@ -205,6 +212,7 @@ pub fn region_weights(
             .filter(|b| b.kind == BoundaryKind::Soft && !has_soft_side[b.joint as usize])
             .map(|b| b.joint)
             .collect(),
+        crowded_vertices,
     })
 }
 

@@ -31,6 +31,7 @@
 
 use super::blend::beta;
 use super::surface_weights::SurfaceWeights;
+use crate::skeleton::ancestry::Ancestry;
 use crate::skeleton::bones::JointBones;
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
@@ -88,48 +89,18 @@ pub fn merge_sibling_blends(
 
 /// The skeleton's tree and bones as the rule needs them.
 struct Family<'a> {
-    parents: Vec<Option<u32>>,
-    depths: Vec<u32>,
+    ancestry: Ancestry,
     bones: &'a JointBones,
     owns_skin: Vec<bool>,
 }
 
 impl<'a> Family<'a> {
     fn new(skeleton: &Skeleton, bones: &'a JointBones, owns_skin: &[bool]) -> Self {
-        let parents: Vec<Option<u32>> = (0..skeleton.len())
-            .map(|j| skeleton.parent(j).map(|p| p as u32))
-            .collect();
         Self {
-            depths: depths(skeleton),
-            parents,
+            ancestry: Ancestry::new(skeleton),
             bones,
             owns_skin: owns_skin.to_vec(),
         }
-    }
-
-    /// The lowest common ancestor of j and k when neither is an ancestor of the other (and
-    /// both are in one tree).
-    fn sibling_ancestor(&self, mut j: u32, mut k: u32) -> Option<u32> {
-        let (dj, dk) = (self.depths[j as usize], self.depths[k as usize]);
-        let lift = |mut x: u32, by: u32| {
-            for _ in 0..by {
-                x = self.parents[x as usize].expect("a joint's depth counts its ancestors");
-            }
-            x
-        };
-        if dj > dk {
-            j = lift(j, dj - dk);
-        } else {
-            k = lift(k, dk - dj);
-        }
-        if j == k {
-            return None;
-        }
-        while j != k {
-            j = self.parents[j as usize]?;
-            k = self.parents[k as usize]?;
-        }
-        Some(j)
     }
 
     /// d_j: the distance from `p` to the nearest bone segment of joint j.
@@ -155,7 +126,7 @@ impl<'a> Family<'a> {
         for x in 0..row.len() {
             for y in x + 1..row.len() {
                 let ((j, wj), (k, wk)) = (row[x], row[y]);
-                let Some(a) = self.sibling_ancestor(j, k) else {
+                let Some(a) = self.ancestry.sibling_ancestor(j, k) else {
                     continue;
                 };
                 if !self.owns_skin[a as usize] {

@@ -3,6 +3,7 @@
 //! (module documentation of [`crate::weights`]).
 
 use super::blend::beta;
+use super::crowding::{Crowding, BATCH};
 use super::ownership::{Ownership, OwnershipBones};
 use crate::ablation::{Rule, RulesOff};
 use crate::decomposition::{Boundary, BoundaryKind, Decomposition};
@@ -16,6 +17,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use rustc_hash::FxHashSet;
 use std::borrow::Cow;
+use std::cell::RefCell;
 use std::collections::VecDeque;
 
 /// A soft boundary, ready for step 3.
@@ -34,6 +36,11 @@ impl SoftSide {
     /// The vertices reached along the surface with their κ_c, by increasing vertex.
     pub fn reached(&self) -> &[(u32, f64)] {
         &self.reached
+    }
+
+    /// Keeps the reached vertices v for which `keep(v)` holds, in order.
+    pub fn retain_reached(&mut self, mut keep: impl FnMut(u32) -> bool) {
+        self.reached.retain(|&(v, _)| keep(v));
     }
 
     /// s_c(p) of the module documentation at a reached vertex at `position`, with its
@@ -66,14 +73,16 @@ impl SoftSide {
 /// mass there anyway (the sides are found deepest joint first). A soft boundary with no
 /// cross-section (diameter 0, or no seed: face bones in a mouth cavity or an eye socket,
 /// whose leaf joints are not seeded farther) is inactive: its joint gets no weight and its
-/// region's other joints keep it.
+/// region's other joints keep it. At most [`super::crowding::MOST_SOFT_SIDES`] sides act at
+/// a vertex, the deepest ([`super::crowding`]); returns the sides and how many vertices
+/// more would have reached.
 pub fn soft_sides(
     decomposition: &Decomposition,
     skeleton: &Skeleton,
     overlaps: &Overlaps,
     related: &Rows<(u32, f64)>,
     rules_off: &RulesOff,
-) -> Vec<SoftSide> {
+) -> (Vec<SoftSide>, usize) {
     let d = decomposition;
     let segments = bone_segments(skeleton);
     let bones = OwnershipBones::new(skeleton, &d.joints, &segments);
@@ -101,11 +110,19 @@ pub fn soft_sides(
             bound[joint as usize] = true;
         }
     }
-    let side = |(k, b): &(usize, Cow<Boundary>), taken: &Taken| {
+    let side = |(k, b): &(usize, Cow<Boundary>), taken: &Taken, crowding: &Crowding| {
         let (k, b) = (*k, b.as_ref());
         let half_width = overlaps.half_widths[k];
         let owner = Ownership::new(&bones, b.joint as usize, b.parent_region, half_width);
-        let in_region = |v: usize| related.row(v).iter().any(|&(r, _)| r == b.parent_region);
+        // A vertex that enough deeper sides reach is not in play ([`super::crowding`]).
+        let refused = RefCell::new(Vec::new());
+        let in_region = |v: usize| {
+            related.row(v).iter().any(|&(r, _)| r == b.parent_region)
+                && (!crowding.full(v) || {
+                    refused.borrow_mut().push(v as u32);
+                    false
+                })
+        };
         let has_children = !children[b.joint as usize].is_empty();
         let seeds = Seeds {
             vertices: &vertices,
@@ -117,7 +134,8 @@ pub fn soft_sides(
             kappa: rules_off.on(Rule::OwnPart),
         };
         let below = |v: usize| taken.below(&bones, v, b.parent_region, b.joint);
-        child_side(d, b, half_width, &owner, in_region, below, &seeds)
+        let side = child_side(d, b, half_width, &owner, in_region, below, &seeds);
+        (side, refused.into_inner())
     };
     // The deepest joints first, those at one depth in parallel: where a joint's side takes
     // the whole share (s = 1), it takes the mass of every joint above it on its region's
@@ -133,21 +151,41 @@ pub fn soft_sides(
     let mut by_depth: Vec<usize> = (0..acting.len()).collect();
     by_depth.sort_by_key(|&i| std::cmp::Reverse(depth[acting[i].1.joint as usize]));
     let mut taken = Taken::new(d.surface.vertex_count());
+    let mut crowding = Crowding::new(d.surface.vertex_count());
     let mut sides: Vec<(usize, SoftSide)> = Vec::with_capacity(acting.len());
     for level in by_depth
         .chunk_by(|&a, &b| depth[acting[a].1.joint as usize] == depth[acting[b].1.joint as usize])
     {
-        let found: Vec<(usize, SoftSide)> = level
-            .par_iter()
-            .filter_map(|&i| side(&acting[i], &taken).map(|s| (i, s)))
-            .collect();
-        for (_, s) in &found {
+        // The level's sides all see the sides of the deeper levels only, whatever their
+        // batches.
+        let level_start = sides.len();
+        for batch in level.chunks(BATCH) {
+            let found: Vec<(usize, Option<SoftSide>, Vec<u32>)> = batch
+                .par_iter()
+                .map(|&i| {
+                    let (s, refused) = side(&acting[i], &taken, &crowding);
+                    (i, s, refused)
+                })
+                .collect();
+            let mut found: Vec<(usize, SoftSide, Vec<u32>)> = found
+                .into_iter()
+                .filter_map(|(i, s, refused)| s.map(|s| (i, s, refused)))
+                .collect();
+            for &v in found.iter().flat_map(|f| &f.2) {
+                crowding.refuse(v);
+            }
+            for (_, side, _) in &mut found {
+                side.retain_reached(|v| crowding.admit(v));
+            }
+            sides.extend(found.into_iter().map(|(i, s, _)| (i, s)));
+        }
+        for (_, s) in &sides[level_start..] {
             taken.record(s, &d.surface.positions);
         }
-        sides.extend(found);
     }
     sides.sort_unstable_by_key(|&(i, _)| i);
-    sides.into_iter().map(|(_, s)| s).collect()
+    let crowded = crowding.crowded_vertices();
+    (sides.into_iter().map(|(_, s)| s).collect(), crowded)
 }
 
 /// Per vertex, a soft side that takes the whole share there (s = 1), by its region and

@@ -68,6 +68,8 @@ pub struct WeightCounts {
     pub gaps: Vec<GapWeighting>,
     /// Joints whose soft boundary is inactive (no cross-section near the joint).
     pub inactive_soft_joints: Vec<u32>,
+    /// Vertices where more soft joints' sides would act than [`super::crowding`] lets in.
+    pub crowded_vertices: usize,
     /// Vertices whose weights on far joints the guard removed (step 4).
     pub far_bone_vertices: usize,
     /// Vertices whose sibling blends gave weight to the siblings' common ancestor (step 3b).
