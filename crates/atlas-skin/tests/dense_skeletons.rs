@@ -93,7 +93,9 @@ fn a_chain_denser_than_its_mesh_is_cut_at_fewer_joints_with_a_warning() {
         .find(|w| w.message.contains("merged for cutting"))
         .expect("a warning");
     assert!(
-        warning.message.starts_with(&format!("{} joint(s) lie closer", merged.len())),
+        warning
+            .message
+            .starts_with(&format!("{} joint(s) lie closer", merged.len())),
         "{warning}"
     );
     assert_rows_whole(&skinned, mesh.positions.len());
@@ -114,7 +116,10 @@ fn a_chain_no_denser_than_its_body_keeps_every_joint() {
     let mesh = capsule();
     let skinned = skin_with_defaults(&mesh, &chain(9, 0.05));
     assert!(skinned.decomposition.merged_joints.is_empty());
-    assert!(!skinned.warnings.iter().any(|w| w.message.contains("merged")));
+    assert!(!skinned
+        .warnings
+        .iter()
+        .any(|w| w.message.contains("merged")));
     assert_rows_whole(&skinned, mesh.positions.len());
 }
 
@@ -171,7 +176,9 @@ fn a_tree_spread_through_a_blob_lets_a_bounded_number_of_soft_joints_act_at_a_ve
         .expect("a warning");
     assert!(
         warning.message.starts_with(&format!("{crowded} vertices"))
-            && warning.message.contains(&format!("only the {MOST_SOFT_SIDES} deepest")),
+            && warning
+                .message
+                .contains(&format!("only the {MOST_SOFT_SIDES} deepest")),
         "{warning}"
     );
     assert_rows_whole(&skinned, mesh.positions.len());
