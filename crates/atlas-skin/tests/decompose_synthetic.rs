@@ -197,9 +197,10 @@ fn parallel_cuts_through_the_same_faces_are_both_kept() {
 
 #[test]
 fn of_two_crossing_cuts_one_becomes_soft() {
-    // b's child bone runs sideways and a little down (staying above a's plane): a plane
-    // separating b's bones tilts at least 2.9°, so it crosses a's perpendicular cut 0.02
-    // below inside the tube (0.02 / tan 2.9° < 0.5).
+    // b's child bone runs sideways and down (staying above a's plane): a plane separating
+    // b's bones tilts at least 13°, so it crosses a's perpendicular cut 0.08 below inside
+    // the tube (0.08 / tan 13° < 0.5). b lies farther from a than 1/8 of its depth in the
+    // body (0.062), so it is not merged into a for cutting (`cuts::merged_joints`).
     let (mesh, _) = capsule_chain(&[DVec3::ZERO, DVec3::Y * 4.0], &[], 0.5, 24, 20);
     let rig = skeleton(
         &["root", "a", "b", "side"],
@@ -207,8 +208,8 @@ fn of_two_crossing_cuts_one_becomes_soft() {
         &[
             DVec3::ZERO,
             DVec3::Y * 2.0,
-            DVec3::Y * 2.02,
-            DVec3::new(0.3, 2.005, 0.0),
+            DVec3::Y * 2.08,
+            DVec3::new(0.3, 2.01, 0.0),
         ],
     );
     let d = run(&mesh, &rig);
