@@ -13,6 +13,7 @@ pub mod deform;
 pub mod fit;
 pub mod matching;
 pub mod rignet_metrics;
+mod row_pair;
 pub mod validity;
 pub mod weights_l1;
 pub mod worst;

@@ -15,6 +15,7 @@
 //!
 //! A benchmark averages each over characters.
 
+use crate::row_pair::RowPair;
 use atlas_skin_runtime::VertexWeights;
 use serde::{Deserialize, Serialize};
 
@@ -47,9 +48,7 @@ pub fn rignet_metrics(
     joint_count: usize,
 ) -> RigNetMetrics {
     debug_assert_eq!(reference.vertex_count(), candidate.vertex_count());
-    let mut dense_ref = vec![0.0f64; joint_count];
-    let mut dense_cand = vec![0.0f64; joint_count];
-    let mut touched: Vec<usize> = Vec::new();
+    let mut rows = RowPair::new(joint_count);
     let (mut vertices, mut both, mut predicted, mut expected) = (0usize, 0usize, 0usize, 0usize);
     let mut l1_sum = 0.0f64;
     for v in 0..reference.vertex_count() {
@@ -58,26 +57,13 @@ pub fn rignet_metrics(
             continue;
         }
         vertices += 1;
-        for (j, w) in reference.row(v) {
-            dense_ref[j as usize] += f64::from(w);
-            touched.push(j as usize);
-        }
-        for (j, w) in candidate.row(v) {
-            dense_cand[j as usize] += f64::from(w);
-            touched.push(j as usize);
-        }
-        touched.sort_unstable();
-        touched.dedup();
-        for &j in &touched {
-            let (r, c) = (dense_ref[j], dense_cand[j]);
+        rows.load(reference, candidate, v);
+        for (_, r, c) in rows.joints() {
             l1_sum += (r - c).abs();
             predicted += usize::from(c > 0.0);
             expected += usize::from(r > 0.0);
             both += usize::from(c > 0.0 && r > 0.0);
-            dense_ref[j] = 0.0;
-            dense_cand[j] = 0.0;
         }
-        touched.clear();
     }
     let share = |part: usize, whole: usize| {
         if whole == 0 {

@@ -1,5 +1,6 @@
 //! How far candidate weights are from the reference's, vertex by vertex.
 
+use crate::row_pair::RowPair;
 use atlas_skin_runtime::VertexWeights;
 use serde::{Deserialize, Serialize};
 
@@ -38,35 +39,18 @@ pub fn weights_l1(
             dominant_agreement: 1.0,
         };
     }
-    let mut dense_ref = vec![0.0f64; joint_count];
-    let mut dense_cand = vec![0.0f64; joint_count];
-    let mut touched: Vec<usize> = Vec::new();
+    let mut rows = RowPair::new(joint_count);
     let mut distances = Vec::with_capacity(n);
     let mut agreeing = 0usize;
     for v in 0..n {
-        for (j, w) in reference.row(v) {
-            dense_ref[j as usize] += f64::from(w);
-            touched.push(j as usize);
-        }
-        for (j, w) in candidate.row(v) {
-            dense_cand[j as usize] += f64::from(w);
-            touched.push(j as usize);
-        }
-        touched.sort_unstable();
-        touched.dedup();
+        rows.load(reference, candidate, v);
         distances.push(
-            touched
-                .iter()
-                .fold(0.0, |sum, &j| sum + (dense_ref[j] - dense_cand[j]).abs()),
+            rows.joints()
+                .fold(0.0, |sum, (_, r, c)| sum + (r - c).abs()),
         );
-        if dominant_joints_agree(&touched, &dense_ref, &dense_cand) {
+        if dominant_joints_agree(&rows) {
             agreeing += 1;
         }
-        for &j in &touched {
-            dense_ref[j] = 0.0;
-            dense_cand[j] = 0.0;
-        }
-        touched.clear();
     }
     let mean = distances.iter().fold(0.0, |sum, d| sum + d) / n as f64;
     distances.sort_unstable_by(f64::total_cmp);
@@ -82,19 +66,18 @@ pub fn weights_l1(
 /// Tolerance under which two weights of one row count as tied for heaviest.
 const TIE: f64 = 1e-6;
 
-/// True when the candidate's heaviest joint among `joints` is one of the reference's
-/// heaviest (only joints with a positive weight count; two rows without any agree).
-fn dominant_joints_agree(joints: &[usize], reference: &[f64], candidate: &[f64]) -> bool {
-    let heaviest = |dense: &[f64]| {
-        joints
-            .iter()
-            .copied()
-            .filter(|&j| dense[j] > 0.0)
-            .max_by(|&a, &b| dense[a].total_cmp(&dense[b]).then(b.cmp(&a)))
+/// True when the candidate's heaviest joint is one of the reference's heaviest (only
+/// joints with a positive weight count; two rows without any agree).
+fn dominant_joints_agree(rows: &RowPair) -> bool {
+    // The heaviest joint of one side (the lower index among exact ties) and its weight.
+    let heaviest = |weight: fn(&(usize, f64, f64)) -> f64| {
+        rows.joints()
+            .filter(|x| weight(x) > 0.0)
+            .max_by(|a, b| weight(a).total_cmp(&weight(b)).then(b.0.cmp(&a.0)))
     };
-    match (heaviest(reference), heaviest(candidate)) {
+    match (heaviest(|x| x.1), heaviest(|x| x.2)) {
         (None, None) => true,
-        (Some(r), Some(c)) => reference[c] >= reference[r] - TIE,
+        (Some((_, r, _)), Some((_, reference_at_c, _))) => reference_at_c >= r - TIE,
         _ => false,
     }
 }

@@ -336,42 +336,37 @@ fn goals(out: &mut String, check: &GroupScores, tune: Option<&GroupScores>) {
     let at_least = |x: Option<f64>, goal: f64| x.is_some_and(|x| x >= goal);
     let _ = writeln!(out, "Goals on the check set:\n");
     let o = check.ours;
-    let _ = writeln!(
-        out,
-        "- L1 ≤ {}: {} ({})",
-        g.l1,
-        cell(o.l1, 3),
-        mark(at_most(o.l1, g.l1))
-    );
-    let _ = writeln!(
-        out,
-        "- precision ≥ {}: {} ({})",
-        g.precision,
-        cell(o.precision, 3),
-        mark(at_least(o.precision, g.precision))
-    );
-    let _ = writeln!(
-        out,
-        "- recall ≥ {}: {} ({})",
-        g.recall,
-        cell(o.recall, 3),
-        mark(at_least(o.recall, g.recall))
-    );
     let (mean, max) = check.ratios_to_nearest().unzip();
-    let _ = writeln!(
-        out,
-        "- deform mean ≤ {:.2}× nearest bone's: {} ({})",
-        g.mean_to_nearest,
-        cell(mean, 2),
-        mark(at_most(mean, g.mean_to_nearest))
-    );
-    let _ = writeln!(
-        out,
-        "- deform max ≤ {:.2}× nearest bone's: {} ({})",
-        g.max_to_nearest,
-        cell(max, 2),
-        mark(at_most(max, g.max_to_nearest))
-    );
+    let lines = [
+        (format!("L1 ≤ {}", g.l1), o.l1, 3, at_most(o.l1, g.l1)),
+        (
+            format!("precision ≥ {}", g.precision),
+            o.precision,
+            3,
+            at_least(o.precision, g.precision),
+        ),
+        (
+            format!("recall ≥ {}", g.recall),
+            o.recall,
+            3,
+            at_least(o.recall, g.recall),
+        ),
+        (
+            format!("deform mean ≤ {:.2}× nearest bone's", g.mean_to_nearest),
+            mean,
+            2,
+            at_most(mean, g.mean_to_nearest),
+        ),
+        (
+            format!("deform max ≤ {:.2}× nearest bone's", g.max_to_nearest),
+            max,
+            2,
+            at_most(max, g.max_to_nearest),
+        ),
+    ];
+    for (goal, value, digits, holds) in lines {
+        let _ = writeln!(out, "- {goal}: {} ({})", cell(value, digits), mark(holds));
+    }
     let _ = writeln!(
         out,
         "- far worse ≤ {:.0}%: {:.1}% ({})",
