@@ -336,8 +336,7 @@ impl FaceSpheres {
         for z in lo.z..=hi.z {
             for y in lo.y..=hi.y {
                 for &f in grid.row(y, z, lo.x, hi.x) {
-                    let (centre, r) = (self.centres[f as usize], self.radii[f as usize]);
-                    if centre.distance_squared(p) <= (radius + r).powi(2) {
+                    if self.is_near(f, p, radius) {
                         faces.push(f);
                     }
                 }
@@ -345,6 +344,58 @@ impl FaceSpheres {
         }
         sort_face_indices(&mut faces, self.centres.len());
         faces
+    }
+
+    /// The faces of [`Self::faces_near`] for which `keep` holds, when there are fewer than
+    /// `limit`; `None` at the `limit`-th, found without looking further (a ball around a
+    /// point deep in a large body holds most of the surface).
+    pub fn fewer_faces_near(
+        &self,
+        p: DVec3,
+        radius: f64,
+        limit: usize,
+        keep: impl Fn(u32) -> bool,
+    ) -> Option<Vec<u32>> {
+        if self.centres.is_empty() {
+            return Some(Vec::new());
+        }
+        let reach = DVec3::splat(radius + self.max_radius);
+        let grid = self.grid();
+        let (lo, hi) = (grid.cell_of(p - reach), grid.cell_of(p + reach));
+        let mut faces = Vec::new();
+        for z in lo.z..=hi.z {
+            for y in lo.y..=hi.y {
+                for &f in grid.row(y, z, lo.x, hi.x) {
+                    if self.is_near(f, p, radius) && keep(f) {
+                        if faces.len() + 1 >= limit {
+                            return None;
+                        }
+                        faces.push(f);
+                    }
+                }
+            }
+        }
+        sort_face_indices(&mut faces, self.centres.len());
+        Some(faces)
+    }
+
+    /// Whether face `f` is one of [`Self::faces_near`] `p` within `radius`: its sphere
+    /// comes within `radius` of `p`.
+    #[inline]
+    pub fn is_near(&self, f: u32, p: DVec3, radius: f64) -> bool {
+        let (centre, r) = (self.centres[f as usize], self.radii[f as usize]);
+        centre.distance_squared(p) <= (radius + r).powi(2)
+    }
+
+    /// Whether every face is one of [`Self::faces_near`] `p` within `radius`; stops at the
+    /// first that is not.
+    pub fn all_near(&self, p: DVec3, radius: f64) -> bool {
+        (0..self.centres.len() as u32).all(|f| self.is_near(f, p, radius))
+    }
+
+    /// The largest radius of a face's sphere.
+    pub fn max_radius(&self) -> f64 {
+        self.max_radius
     }
 
     /// Appends to `out` the faces whose sphere comes within `radius` of the segment
