@@ -156,12 +156,19 @@ impl PointGrid {
     /// side radius (1 + 10⁻⁹): a point whose computed distance passes lies in that box
     /// despite the rounding of its distance.
     pub fn within(&self, p: DVec3, radius: f64) -> Vec<u32> {
+        self.within_where(p, radius, |_| true)
+    }
+
+    /// The points of [`Self::within`] for which `keep(index)` holds, in the same order;
+    /// only those are sorted (the seeds of a soft side in a band across a ball that holds
+    /// most of a large surface).
+    pub fn within_where(&self, p: DVec3, radius: f64, keep: impl Fn(u32) -> bool) -> Vec<u32> {
         let reach = DVec3::splat(radius * (1.0 + 1e-9));
         let (lo, hi) = (self.grid.cell_of(p - reach), self.grid.cell_of(p + reach));
         let mut found: Vec<u32> = self
             .grid
             .faces_in(lo, hi, IVec3::ONE, IVec3::ZERO)
-            .filter(|&k| self.points[k as usize].distance(p) <= radius)
+            .filter(|&k| self.points[k as usize].distance(p) <= radius && keep(k))
             .collect();
         found.sort_unstable();
         found

@@ -287,14 +287,15 @@ impl<'a> NearVertices<'a> {
         Self::Grid(PointGrid::new(positions))
     }
 
-    fn within(&self, p: DVec3, radius: f64) -> Vec<u32> {
+    /// The vertices within `radius` of `p` for which `keep(vertex)` holds, increasing.
+    fn within(&self, p: DVec3, radius: f64, keep: impl Fn(u32) -> bool) -> Vec<u32> {
         match self {
             Self::Scan(positions) => (0u32..)
                 .zip(positions.iter())
-                .filter(|&(_, &q)| point_segment_distance(p, q, q) <= radius)
+                .filter(|&(v, &q)| point_segment_distance(p, q, q) <= radius && keep(v))
                 .map(|(v, _)| v)
                 .collect(),
-            Self::Grid(grid) => grid.within(p, radius),
+            Self::Grid(grid) => grid.within_where(p, radius, keep),
         }
     }
 
@@ -366,9 +367,9 @@ fn child_side(
     // flood's result does not depend on their order).
     let seed_radius = b.diameter.max(half_width);
     let near_band = |radius: f64| {
-        let mut near = seeds.vertices.within(b.point, radius);
-        near.retain(|&v| signed(v as usize) <= half_width);
-        near
+        seeds
+            .vertices
+            .within(b.point, radius, |v| signed(v as usize) <= half_width)
     };
     for v in near_band(seed_radius) {
         visit(v, &mut queue);
@@ -460,11 +461,19 @@ mod tests {
             assert_eq!(scan.nearest(p), grid.nearest(p), "nearest to {p}");
             let exact = p.distance(vertex);
             for radius in [0.0, exact, exact * (1.0 - 1e-12), 0.3 * point().x] {
-                let found = scan.within(p, radius);
-                assert_eq!(found, grid.within(p, radius), "{p} within {radius}");
+                let found = scan.within(p, radius, |_| true);
+                assert_eq!(
+                    found,
+                    grid.within(p, radius, |_| true),
+                    "{p} within {radius}"
+                );
                 assert_eq!(found.contains(&(k as u32)), radius >= exact);
+                let odd = |v: u32| v % 2 == 1;
+                let odd_found: Vec<u32> = found.iter().copied().filter(|&v| odd(v)).collect();
+                assert_eq!(scan.within(p, radius, odd), odd_found);
+                assert_eq!(grid.within(p, radius, odd), odd_found);
             }
         }
-        assert_eq!(scan.within(positions[7], 0.0), [7]);
+        assert_eq!(scan.within(positions[7], 0.0, |_| true), [7]);
     }
 }
