@@ -11,13 +11,18 @@
 //! work over all leaves is bounded by the surface's vertices, where asking the vertices of
 //! the faces within 2 reach of p ([`leaf_reaches_in_ball`], the reference) cost a leaf deep
 //! in a blob most of the surface (a tree of 4,096 leaves spread through a sphere of
-//! 100,000 vertices: two thirds of its decomposition, issue 45).
+//! 100,000 vertices: two thirds of its decomposition, issue 45). A vertex with more than
+//! [`MOST_NEAREST`] nearest bones (bones lying along one another: thousands of siblings of
+//! one root along a tube are all as near to each vertex of the tube) is listed under none
+//! and asked by every leaf whose ball holds it, from a grid of those vertices, as the
+//! reference asks every vertex.
 
 use crate::geometry::point_segment_distance;
 use crate::mesh::spatial_index::FaceSpheres;
 use crate::mesh::SurfaceMesh;
 use crate::rows::{Rows, PAR_CHUNK};
 use crate::skeleton::bones::BoneIndex;
+use crate::skeleton::nearest_point::PointGrid;
 use glam::DVec3;
 
 /// Rule 5 counts the vertices within 60° of the leaf's bone (cos 60° = ½): toes turn
@@ -31,6 +36,10 @@ const PAST_COSINE: f64 = 0.5;
 /// nearest, the leaf's own bone included.
 const NEAREST_TIE: f64 = 1e-6;
 
+/// A vertex is listed under at most this many nearest bones (a real rig's bones meet a few
+/// at a joint).
+const MOST_NEAREST: usize = 8;
+
 /// What rule 5's question reads: the surface, its faces indexed, the skeleton's bones, and
 /// each bone's vertices (those of some face whose nearest bones include it).
 pub struct LeafReach<'a> {
@@ -41,6 +50,10 @@ pub struct LeafReach<'a> {
     bones_at: Rows<u32>,
     /// The vertices, increasing, of each bone.
     vertices_of: Rows<u32>,
+    /// The vertices of some face with more than [`MOST_NEAREST`] nearest bones,
+    /// increasing, and a grid of their positions (when there are some).
+    crowded: Vec<u32>,
+    crowded_grid: Option<PointGrid>,
 }
 
 impl<'a> LeafReach<'a> {
@@ -62,24 +75,43 @@ impl<'a> LeafReach<'a> {
                 on_face[v as usize] = true;
             }
         }
-        let nearest: Rows<u32> = Rows::par_build(
+        // Each vertex's nearest bones, or `None` (as one entry) for a crowded vertex.
+        let nearest: Rows<Option<u32>> = Rows::par_build(
             mesh.vertex_count(),
             PAR_CHUNK,
-            |v, _: &mut (), out: &mut Vec<u32>| {
+            |v, _: &mut (), out: &mut Vec<Option<u32>>| {
                 if on_face[v] {
-                    out.extend(bones.nearest_bones(mesh.positions[v], NEAREST_TIE));
+                    let p = mesh.positions[v];
+                    match bones.nearest_bones(p, NEAREST_TIE, MOST_NEAREST) {
+                        Some(near) => out.extend(near.into_iter().map(Some)),
+                        None => out.push(None),
+                    }
                 }
             },
         );
-        let entries = (0..mesh.vertex_count())
-            .flat_map(|v| nearest.row(v).iter().map(move |&k| (k as usize, v as u32)));
-        let vertices_of = Rows::group(pairs.len(), entries);
+        let listed = (0..mesh.vertex_count()).flat_map(|v| {
+            let row = nearest.row(v).iter();
+            row.filter_map(move |&k| k.map(|k| (k as usize, v as u32)))
+        });
+        let vertices_of = Rows::group(pairs.len(), listed);
+        let crowded: Vec<u32> = (0..mesh.vertex_count() as u32)
+            .filter(|&v| nearest.row(v as usize) == [None])
+            .collect();
+        let crowded_grid = (!crowded.is_empty()).then(|| {
+            let at: Vec<DVec3> = crowded
+                .iter()
+                .map(|&v| mesh.positions[v as usize])
+                .collect();
+            PointGrid::new(&at)
+        });
         Self {
             mesh,
             spheres,
             bones,
             bones_at,
             vertices_of,
+            crowded,
+            crowded_grid,
         }
     }
 
@@ -107,10 +139,16 @@ impl<'a> LeafReach<'a> {
             );
         }
         let shell = Shell::new(self.mesh, p, direction, reach, on_piece);
+        let crowded = self
+            .crowded_grid
+            .iter()
+            .flat_map(|grid| grid.within(p, 2.0 * reach))
+            .map(|i| self.crowded[i as usize]);
         let mut vertices: Vec<u32> = own
             .iter()
             .flat_map(|&k| self.vertices_of.row(k as usize))
             .copied()
+            .chain(crowded)
             .filter(|&v| shell.holds(v))
             .collect();
         vertices.sort_unstable();
@@ -211,14 +249,15 @@ mod tests {
 
     /// The answer from each bone's vertices is the ball's at every leaf of random trees
     /// spread through a tube and a sphere (leaves deep in the body, beside other bones, at
-    /// a parent's point: no bone of their own), for reaches from a hundredth of the body to
+    /// a parent's point: no bone of their own) and of siblings along one line (crowded
+    /// vertices), for reaches from a hundredth of the body to
     /// all of it, in random directions, with and without a piece; both answers occur.
     #[test]
     fn each_bones_vertices_answer_as_the_ball() {
         let mut rng = SplitMix64::new(45);
         let (tube, _) = capsule_chain(&[DVec3::ZERO, 2.0 * DVec3::Y], &[], 0.4, 16, 24);
         let sphere = crate::fixtures::shapes::icosphere(1.0, 4);
-        let (mut yes, mut no) = (0, 0);
+        let (mut yes, mut no, mut crowded) = (0, 0, 0);
         for mesh in [&tube, &sphere] {
             let spheres = FaceSpheres::new(mesh);
             let pieces = Topology::new(mesh).vertex_component;
@@ -226,14 +265,23 @@ mod tests {
             let point = |rng: &mut SplitMix64| {
                 lo + (hi - lo) * DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64())
             };
-            for _ in 0..6 {
-                // A random tree of 60 joints, the last few at their parent's point.
+            for trial in 0..7 {
+                // A random tree of 60 joints, the last few at their parent's point; last,
+                // 59 siblings of one root along a line through the body (bones lying along
+                // one another: crowded vertices).
                 let mut positions = vec![point(&mut rng)];
                 let mut parents = vec![usize::MAX];
+                let line = (positions[0], point(&mut rng));
                 for j in 1..60 {
-                    let parent = (rng.next_f64() * j as f64) as usize;
+                    let parent = if trial == 6 {
+                        0
+                    } else {
+                        (rng.next_f64() * j as f64) as usize
+                    };
                     parents.push(parent);
-                    let at = if j >= 56 {
+                    let at = if trial == 6 {
+                        line.0.lerp(line.1, j as f64 / 59.0)
+                    } else if j >= 56 {
                         positions[parent]
                     } else {
                         point(&mut rng)
@@ -246,6 +294,7 @@ mod tests {
                     .collect();
                 let bones = BoneIndex::new(pairs, &positions);
                 let fast = LeafReach::new(mesh, &spheres, &bones, positions.len());
+                crowded += fast.crowded.len();
                 for leaf in (1..60).filter(|j| !parents.contains(j)) {
                     for reach in [0.01, 0.1, 0.3, 1.0, 3.0] {
                         let direction = (point(&mut rng) - point(&mut rng)).normalize_or(DVec3::Y);
@@ -267,6 +316,6 @@ mod tests {
                 }
             }
         }
-        assert!(yes > 50 && no > 50, "{yes} {no}");
+        assert!(yes > 50 && no > 50 && crowded > 0, "{yes} {no} {crowded}");
     }
 }

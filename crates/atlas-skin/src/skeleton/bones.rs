@@ -195,13 +195,14 @@ impl BoneIndex {
     }
 
     /// The bones, increasing, within (1 + `tie`) times the distance of the nearest bone to
-    /// `p` (every bone at that distance, and those a rounding away); none without bones.
-    pub fn nearest_bones(&self, p: DVec3, tie: f64) -> Vec<u32> {
+    /// `p` (every bone at that distance, and those a rounding away), when there are at most
+    /// `most` of them; none without bones.
+    pub fn nearest_bones(&self, p: DVec3, tie: f64, most: usize) -> Option<Vec<u32>> {
         let nearest = self.tree.nearest(p);
         if nearest.is_finite() {
-            self.tree.within(p, nearest * (1.0 + tie))
+            self.tree.within_at_most(p, nearest * (1.0 + tie), most)
         } else {
-            Vec::new()
+            Some(Vec::new())
         }
     }
 
