@@ -324,26 +324,8 @@ impl FaceSpheres {
     /// Faces whose sphere meets the ball of `radius` around `p` (a superset of the faces
     /// that meet the ball), in face order.
     pub fn faces_near(&self, p: DVec3, radius: f64) -> Vec<u32> {
-        if self.centres.is_empty() {
-            return Vec::new();
-        }
-        let reach = DVec3::splat(radius + self.max_radius);
-        let grid = self.grid();
-        let (lo, hi) = (grid.cell_of(p - reach), grid.cell_of(p + reach));
-        // The rows of the box as plain loops: the faces of `CentreGrid::faces_in` (with
-        // nothing skipped) in the same order, without its chain of adapters per face.
-        let mut faces = Vec::new();
-        for z in lo.z..=hi.z {
-            for y in lo.y..=hi.y {
-                for &f in grid.row(y, z, lo.x, hi.x) {
-                    if self.is_near(f, p, radius) {
-                        faces.push(f);
-                    }
-                }
-            }
-        }
-        sort_face_indices(&mut faces, self.centres.len());
-        faces
+        self.fewer_faces_near(p, radius, usize::MAX, |_| true)
+            .unwrap_or_default()
     }
 
     /// The faces of [`Self::faces_near`] for which `keep` holds, when there are fewer than
@@ -362,6 +344,8 @@ impl FaceSpheres {
         let reach = DVec3::splat(radius + self.max_radius);
         let grid = self.grid();
         let (lo, hi) = (grid.cell_of(p - reach), grid.cell_of(p + reach));
+        // The rows of the box as plain loops: the faces of `CentreGrid::faces_in` (with
+        // nothing skipped) in the same order, without its chain of adapters per face.
         let mut faces = Vec::new();
         for z in lo.z..=hi.z {
             for y in lo.y..=hi.y {
@@ -1136,6 +1120,12 @@ mod tests {
                 })
                 .collect();
             assert_eq!(spheres.faces_near(p, radius), near, "{p} {radius}");
+            // With a limit and a filter: the kept faces below the limit, none at it.
+            let odd: Vec<u32> = near.iter().copied().filter(|f| f % 2 == 1).collect();
+            for limit in [odd.len().max(1), odd.len() + 1] {
+                let fewer = spheres.fewer_faces_near(p, radius, limit, |f| f % 2 == 1);
+                assert_eq!(fewer, (limit > odd.len()).then(|| odd.clone()), "{limit}");
+            }
         }
     }
 }
