@@ -119,7 +119,7 @@ impl CentreGrid {
     }
 
     /// Faces of the cells x0..=x1 of row (y, z), empty when x0 > x1.
-    fn row(&self, y: i32, z: i32, x0: i32, x1: i32) -> &[u32] {
+    pub(crate) fn row(&self, y: i32, z: i32, x0: i32, x1: i32) -> &[u32] {
         if x0 > x1 {
             return &[];
         }
