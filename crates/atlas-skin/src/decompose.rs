@@ -68,6 +68,7 @@ pub fn decompose(
         topology,
         spheres: &spheres,
         vertex_snap: &vertex_snap,
+        max_snap: vertex_snap.iter().copied().fold(0.0, f64::max),
         params,
     };
     let searches = search_all_cuts(&cut_surface, &bones, &plans);

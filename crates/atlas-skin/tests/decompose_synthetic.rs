@@ -467,6 +467,7 @@ fn joints_on_another_bone_skip_a_search_that_would_find_nothing() {
         topology: &topology,
         spheres: &spheres,
         vertex_snap: &vertex_snap,
+        max_snap: vertex_snap.iter().copied().fold(0.0, f64::max),
         params: &params,
     };
     let mut scratch = DomainScratch::default();

@@ -63,9 +63,9 @@
 //! x · n = c, among the coordinate planes and the bisector planes of sibling pairs of equal
 //! bone length, that maps the joint set best onto itself.
 
+use super::leaf_reach::LeafReach;
 use super::params::{DecomposeParams, Override};
 use crate::ablation::Rule;
-use crate::geometry::point_segment_distance;
 use crate::mesh::spatial_index::FaceSpheres;
 use crate::mesh::SurfaceMesh;
 use crate::skeleton::bones::BoneIndex;
@@ -143,11 +143,6 @@ const ON_PLANE: f64 = 0.25;
 /// 2–7 times; a fingertip cap around an end site about 1.4–1.7 times).
 const LEAF_REACH_RATIO: f64 = 2.0;
 
-/// Rule 5 (b) counts the vertices within 60° of the leaf's bone (cos 60° = ½): toes turn
-/// about 45° from a foot bone, while the rim of a broad flat end (a pad under an end site)
-/// lies across it.
-const PAST_COSINE: f64 = 0.5;
-
 /// Rule 5 (b) applies to a joint at least this fraction of its bone from the surface; one
 /// nearer lies in the skin (a face bone): the part nearest to it is a patch of skin, not a
 /// part of the body past it.
@@ -180,7 +175,7 @@ pub fn plan_joints(
         symmetry,
         twins: mirror_twins(symmetry, positions, params.symmetry_tolerance),
         orientation: orientation_sign(mesh),
-        bones,
+        leaf_reach: LeafReach::new(mesh, spheres, bones, skeleton.len()),
         params,
     };
     (0..skeleton.len())
@@ -207,8 +202,9 @@ struct Rig<'a> {
     twins: Vec<Option<u32>>,
     /// [`orientation_sign`] of the surface.
     orientation: f64,
-    /// The skeleton's bones ([`crate::skeleton::bones::joint_pairs`]).
-    bones: &'a BoneIndex,
+    /// Rule 5's question at the leaves, with the skeleton's bones
+    /// ([`crate::skeleton::bones::joint_pairs`]).
+    leaf_reach: LeafReach<'a>,
     params: &'a DecomposeParams,
 }
 
@@ -261,7 +257,7 @@ impl Rig<'_> {
                 self.pieces,
                 self.spheres,
                 &frame,
-                |radius| self.bones.near(j, self.positions[j], radius),
+                (&self.leaf_reach, j),
                 self.orientation,
                 self.params.leaf_extent_ratio,
             ) {
@@ -382,15 +378,16 @@ enum LeafPart {
     None,
 }
 
-/// Rule 5 of the module documentation for the leaf of `frame`. `pieces`: the connected piece
-/// of every vertex; `other_bones(radius)`: the bones not at the leaf within `radius` of it,
-/// as segments; `orientation` as from [`orientation_sign`].
+/// Rule 5 of the module documentation for the leaf `leaf` of `frame`. `pieces`: the
+/// connected piece of every vertex; `reach`: the surface and the bones (its question of
+/// (b) and (c)); `orientation` as from [`orientation_sign`].
+#[allow(clippy::too_many_arguments)]
 fn leaf_part(
     mesh: &SurfaceMesh,
     pieces: &[u32],
     spheres: &FaceSpheres,
     frame: &JointFrame,
-    other_bones: impl Fn(f64) -> Vec<[DVec3; 2]>,
+    (reach, leaf): (&LeafReach, usize),
     orientation: f64,
     extent_ratio: f64,
 ) -> LeafPart {
@@ -408,78 +405,18 @@ fn leaf_part(
         .map(|nearest| pieces[mesh.triangles[nearest.face as usize][0] as usize]);
     if let Some(piece) = bone_piece {
         let on_piece = Some((pieces, piece));
-        let past_bone = leaf_reaches(
-            mesh,
-            spheres,
-            p,
-            bone,
-            frame.bone_length,
-            &other_bones,
-            on_piece,
-        );
-        if past_bone {
+        if reach.reaches(leaf, p, bone, frame.bone_length, on_piece) {
             return LeafPart::PastBone;
         }
     }
     if radius < INTERIOR_RADIUS * frame.bone_length {
         return LeafPart::None;
     }
-    if leaf_reaches(
-        mesh,
-        spheres,
-        p,
-        bone,
-        LEAF_REACH_RATIO * radius,
-        other_bones,
-        None,
-    ) {
+    if reach.reaches(leaf, p, bone, LEAF_REACH_RATIO * radius, None) {
         LeafPart::Owned
     } else {
         LeafPart::None
     }
-}
-
-/// Whether the part beyond a leaf joint at `p` reaches `reach` from it: whether some
-/// surface vertex v with `reach` ≤ |v − p| ≤ 2 `reach`, nearer to `p` than to each bone of
-/// `other_bones(radius)` (the bones not at the leaf within `radius` of `p`), lies past it
-/// within 60° of the unit `direction` ((v − p) · direction ≥ ½ |v − p|).
-fn leaf_reaches(
-    mesh: &SurfaceMesh,
-    spheres: &FaceSpheres,
-    p: DVec3,
-    direction: DVec3,
-    reach: f64,
-    other_bones: impl Fn(f64) -> Vec<[DVec3; 2]>,
-    on_piece: Option<(&[u32], u32)>,
-) -> bool {
-    let radius = 2.0 * reach;
-    let mut vertices: Vec<u32> = spheres
-        .faces_near(p, radius)
-        .into_iter()
-        .flat_map(|f| mesh.triangles[f as usize])
-        .collect();
-    vertices.sort_unstable();
-    vertices.dedup();
-    if let Some((pieces, piece)) = on_piece {
-        vertices.retain(|&v| pieces[v as usize] == piece);
-    }
-    if vertices.is_empty() {
-        return false;
-    }
-    // A bone nearer than p to a vertex within ρ of p lies within 2ρ of p (3ρ leaves room
-    // for rounding): the others need no test.
-    let bones = other_bones(3.0 * radius);
-    vertices
-        .into_iter()
-        .map(|v| mesh.positions[v as usize])
-        .any(|v| {
-            let d = v.distance(p);
-            (reach..=radius).contains(&d)
-                && (v - p).dot(direction) >= PAST_COSINE * d
-                && !bones
-                    .iter()
-                    .any(|&[a, b]| point_segment_distance(v, a, b) <= d)
-        })
 }
 
 /// Whether at least four of six rays from `p` first meet the surface leaving it (the hit
@@ -770,12 +707,16 @@ mod tests {
             leaf_part_past: false,
         };
         let ratio = crate::DecomposeParams::default().leaf_extent_ratio;
+        // The leaf (joint 1) and its parent: its bone is the only one.
+        let positions = [position - bone_length * upper, position];
+        let bones = BoneIndex::new(vec![(0, 1)], &positions);
+        let reach = LeafReach::new(mesh, &spheres, &bones, 2);
         leaf_part(
             mesh,
             pieces,
             &spheres,
             &frame,
-            |_| Vec::new(),
+            (&reach, 1),
             orientation_sign(mesh),
             ratio,
         )

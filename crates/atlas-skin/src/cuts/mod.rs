@@ -1,5 +1,5 @@
 //! Boundaries at the joints (Lu et al. 2008 §3.1): which joints get one
-//! ([`joint_roles`]; joints too close to the boundary above them merged for cutting:
+//! ([`joint_roles`], with [`leaf_reach`] for its leaves; joints too close to the boundary above them merged for cutting:
 //! [`merged_joints`]), the plane search through each ([`plane_search`]) over the closed
 //! sections of the surface by a plane ([`plane_section`]), the conflict rule between cuts
 //! ([`conflicts`]) and the split of the surface along the kept curves ([`split`]).
@@ -11,6 +11,7 @@
 
 pub mod conflicts;
 pub mod joint_roles;
+pub mod leaf_reach;
 pub mod merged_joints;
 pub mod params;
 pub mod plane_search;

@@ -56,6 +56,8 @@ pub struct CutSurface<'a> {
     pub spheres: &'a FaceSpheres,
     /// #V snap distances ([`crate::cuts::plane_section::vertex_snap_distances`]).
     pub vertex_snap: &'a [f64],
+    /// The largest of `vertex_snap`.
+    pub max_snap: f64,
     pub params: &'a DecomposeParams,
 }
 
@@ -158,12 +160,13 @@ pub fn search_cut_candidates(
         surface.params.neighbourhood_factor * frame.surface_distance.max(0.1 * frame.bone_length);
     let mut last = CutSearch::default();
     for _ in 0..NEIGHBOURHOOD_ATTEMPTS {
-        let faces = surface.spheres.faces_near(frame.position, radius);
-        let everything = faces.len() == surface.mesh.triangle_count();
         let near_bones = bones.near(joint, frame.position, 2.0 * radius);
         let (search, every_plane_encloses) =
-            search_within(surface, frame, &near_bones, faces, scratch);
-        if !search.candidates.is_empty() || everything || every_plane_encloses {
+            search_within(surface, frame, &near_bones, radius, scratch);
+        if !search.candidates.is_empty()
+            || every_plane_encloses
+            || surface.spheres.all_near(frame.position, radius)
+        {
             return search;
         }
         last = search;
@@ -172,7 +175,8 @@ pub fn search_cut_candidates(
     last
 }
 
-/// The search of [`find_cut_candidates`] on the sections within `faces`, and whether it
+/// The search of [`find_cut_candidates`] on the sections of the faces near the joint
+/// within `radius` ([`FaceSpheres::faces_near`]), and whether it
 /// found no candidate because every sampled plane has a closed section around the joint
 /// that encloses another bone. A larger neighbourhood then finds none either (issue 45: a
 /// chain coiled in a capsule searched each of its joints in three neighbourhoods, the last
@@ -186,18 +190,24 @@ fn search_within(
     surface: &CutSurface,
     frame: &JointFrame,
     other_bones: &[[DVec3; 2]],
-    faces: Vec<u32>,
+    radius: f64,
     scratch: &mut DomainScratch,
 ) -> (CutSearch, bool) {
     let (mesh, topology, params) = (surface.mesh, surface.topology, surface.params);
     let mut search = PlaneSearch {
         mesh,
         topology,
-        spheres: surface.spheres,
         other_bones,
         enclosing_other_bones: 0,
         position: frame.position,
-        domain: JointSections::new(mesh, topology, surface.vertex_snap, faces, scratch),
+        domain: JointSections::new(
+            mesh,
+            topology,
+            (surface.vertex_snap, surface.max_snap),
+            surface.spheres,
+            (frame.position, radius),
+            scratch,
+        ),
         basis: NormalBasis::new(frame.upper, frame.lower),
         evaluated: Vec::new(),
     };
@@ -351,8 +361,6 @@ impl NormalBasis {
 struct PlaneSearch<'a> {
     mesh: &'a SurfaceMesh,
     topology: &'a Topology,
-    /// The faces of `mesh` indexed (the sections around J are found through them).
-    spheres: &'a FaceSpheres,
     /// Bones not incident to J near it, as segments.
     other_bones: &'a [[DVec3; 2]],
     /// Count of sections around J turned down for enclosing another bone.
@@ -425,7 +433,7 @@ impl PlaneSearch<'_> {
             normal,
         };
         let mut best: Option<CutCandidate> = None;
-        for curve in self.domain.sections_around(&plane, self.spheres) {
+        for curve in self.domain.sections_around(&plane) {
             let points = curve.positions(self.mesh, self.topology);
             if !polygon_contains(&points, plane.normal, plane.point) {
                 continue;
@@ -491,13 +499,12 @@ mod tests {
             joint + 0.05 * DVec3::X - 0.1 * DVec3::Y,
             joint + 0.05 * DVec3::X + 0.1 * DVec3::Y,
         ]];
-        let faces: Vec<u32> = (0..mesh.triangle_count() as u32).collect();
+        let max_snap = snap.iter().copied().fold(0.0, f64::max);
         let (mut scratch, mut other_scratch) = (DomainScratch::default(), DomainScratch::default());
         for other_bones in [&[][..], &through[..]] {
             let new_search = |domain| PlaneSearch {
                 mesh: &mesh,
                 topology: &topology,
-                spheres: &spheres,
                 other_bones,
                 enclosing_other_bones: 0,
                 position: joint,
@@ -505,8 +512,10 @@ mod tests {
                 basis: NormalBasis::new(DVec3::Y, DVec3::new(0.6f64.sin(), 0.6f64.cos(), 0.0)),
                 evaluated: Vec::new(),
             };
+            // Every face: a ball far larger than the tube.
+            let (snap, ball) = ((snap.as_slice(), max_snap), (joint, 100.0));
             let domain =
-                |scratch| JointSections::new(&mesh, &topology, &snap, faces.clone(), scratch);
+                |scratch| JointSections::new(&mesh, &topology, snap, &spheres, ball, scratch);
             let (mut reused, mut computed) = (
                 new_search(domain(&mut scratch)),
                 new_search(domain(&mut other_scratch)),

@@ -245,20 +245,18 @@ const SEGMENT_QUERY_FACES: usize = 500;
 /// index) used while building a [`SectionDomain`]: allocated once per thread for the whole
 /// mesh and cleared entry by entry, so that a domain costs O(its faces).
 ///
-/// A [`NearRayDomain`] uses more maps: the mark of the domain that last held each face,
-/// the stamp of the query that last visited each edge, and of the query that last computed
-/// each vertex's snapped signed distance (kept beside), with the last mark and stamp given
-/// (numbers that only grow, so that no map is cleared but when they wrap).
+/// A [`NearRayDomain`] uses more maps: the stamp of the query that last visited each
+/// edge, and of the query that last computed each vertex's snapped signed distance (kept
+/// beside), with the last stamp given (a number that only grows, so that no map is cleared
+/// but when it wraps).
 #[derive(Debug, Clone, Default)]
 pub struct DomainScratch {
     vertex: Vec<u32>,
     edge: Vec<u32>,
     face: Vec<u32>,
-    face_domain: Vec<u32>,
     edge_query: Vec<u32>,
     vertex_query: Vec<u32>,
     vertex_distance: Vec<f64>,
-    domain: u32,
     query: u32,
 }
 
@@ -277,17 +275,10 @@ impl DomainScratch {
         }
     }
 
-    /// Grows the maps of a [`NearRayDomain`] to the mesh's sizes (new entries hold no mark
-    /// and no stamp: 0).
+    /// Grows the maps of a [`NearRayDomain`] to the mesh's sizes (new entries hold no
+    /// stamp: 0).
     fn fit_marks(&mut self, mesh: &SurfaceMesh, topology: &Topology) {
-        let (faces, edges, vertices) = (
-            mesh.triangle_count(),
-            topology.edges.len(),
-            mesh.vertex_count(),
-        );
-        if self.face_domain.len() < faces {
-            self.face_domain.resize(faces, 0);
-        }
+        let (edges, vertices) = (topology.edges.len(), mesh.vertex_count());
         if self.edge_query.len() < edges {
             self.edge_query.resize(edges, 0);
         }
@@ -295,16 +286,6 @@ impl DomainScratch {
             self.vertex_query.resize(vertices, 0);
             self.vertex_distance.resize(vertices, 0.0);
         }
-    }
-
-    /// A new domain's mark (never 0).
-    fn next_domain(&mut self) -> u32 {
-        self.domain = self.domain.wrapping_add(1);
-        if self.domain == 0 {
-            self.face_domain.fill(0);
-            self.domain = 1;
-        }
-        self.domain
     }
 
     /// A new query's stamp (never 0).
@@ -581,24 +562,31 @@ impl ChainDomain for SectionDomain {
 
 /// The faces near one joint, asked only for the closed sections around the joint's point
 /// ([`NearRayDomain::sections_around`]): a large domain, of which a plane's query traces
-/// the few crossed faces near one ray. Nothing is indexed locally: the faces are marked in
-/// the mesh-sized maps of [`DomainScratch`] (by a number per domain, so that nothing is
-/// cleared), a vertex's signed distance is computed when a query's tracing first reads it
-/// (and kept there for the query), and the edges a query visits are stamped there too. Building one is a pass over its faces'
-/// corners (their box and largest snap distance), where a [`SectionDomain`] costs about
-/// 315 instructions a face (on makehuman) for local arrays that such a query barely reads;
-/// the tracing is the same (the trait `ChainDomain`).
+/// the few crossed faces near one ray. Nothing is gathered or indexed locally: a face is in
+/// the domain when its sphere comes within the domain's radius of its centre (the test of
+/// [`FaceSpheres::faces_near`]) and it has no repeated vertex index, a vertex's signed
+/// distance is computed when a query's tracing first reads it (and kept for the query in
+/// the mesh-sized maps of [`DomainScratch`]), and the edges a query visits are stamped
+/// there too. Building one costs nothing per face, where gathering the faces of the ball
+/// cost each joint the surface within 4 r of it: a tree of 5,461 joints spread through a
+/// sphere of 100,000 vertices gathered most of the sphere for each of its 2,167 searched
+/// joints (issue 45); a [`SectionDomain`] costs about 315 instructions a face (on
+/// makehuman) for local arrays that such a query barely reads. The tracing is the same
+/// (the trait `ChainDomain`).
 #[derive(Debug)]
 pub struct NearRayDomain<'a> {
     mesh: &'a SurfaceMesh,
     topology: &'a Topology,
     vertex_snap: &'a [f64],
+    spheres: &'a FaceSpheres,
     scratch: &'a mut DomainScratch,
-    /// This domain's mark in `scratch.face_domain`.
-    mark: u32,
+    /// The domain's ball: the faces whose spheres come within `radius` of `centre`.
+    centre: DVec3,
+    radius: f64,
     /// The plane of the current query.
     plane: Plane,
-    /// The box of the domain's vertices and their largest snap distance (what
+    /// A box holding the domain's vertices (the ball grown by the largest face's
+    /// diameter) and the largest snap distance of the mesh's vertices (what
     /// [`Self::sections_around`] bounds its segment by).
     bounds: [DVec3; 2],
     max_snap: f64,
@@ -608,43 +596,34 @@ pub struct NearRayDomain<'a> {
 }
 
 impl<'a> NearRayDomain<'a> {
-    /// A domain of `faces` of `mesh` (none with a repeated vertex index).
+    /// The domain of the faces of `mesh` (indexed by `spheres`) whose spheres come within
+    /// `radius` of `centre`, but those with a repeated vertex index; `max_snap`: the
+    /// largest of `vertex_snap`.
     fn new(
         mesh: &'a SurfaceMesh,
         topology: &'a Topology,
-        vertex_snap: &'a [f64],
-        faces: &[u32],
+        (vertex_snap, max_snap): (&'a [f64], f64),
+        spheres: &'a FaceSpheres,
+        (centre, radius): (DVec3, f64),
         scratch: &'a mut DomainScratch,
     ) -> Self {
         scratch.fit_marks(mesh, topology);
-        let mark = scratch.next_domain();
-        // Plain comparisons, not `f64::min` and `max` (which handle NaN, at several
-        // instructions each): the coordinates and snap distances are finite, and a zero's
-        // sign in the box changes nothing the box is used for.
-        let (mut lo, mut hi, mut max_snap) = (DVec3::INFINITY, DVec3::NEG_INFINITY, 0.0f64);
-        for &f in faces {
-            scratch.face_domain[f as usize] = mark;
-            let [a, b, c] = mesh.triangles[f as usize];
-            for v in [a, b, c] {
-                let p = mesh.positions[v as usize];
-                let below = |x: f64, y: f64| if x < y { x } else { y };
-                let above = |x: f64, y: f64| if x > y { x } else { y };
-                lo = DVec3::new(below(p.x, lo.x), below(p.y, lo.y), below(p.z, lo.z));
-                hi = DVec3::new(above(p.x, hi.x), above(p.y, hi.y), above(p.z, hi.z));
-                max_snap = above(vertex_snap[v as usize], max_snap);
-            }
-        }
+        // A vertex of a face in the domain lies within the face's radius r of its centre,
+        // which lies within `radius` + r of `centre`.
+        let reach = DVec3::splat(radius + 2.0 * spheres.max_radius());
         Self {
             mesh,
             topology,
             vertex_snap,
+            spheres,
             scratch,
-            mark,
+            centre,
+            radius,
             plane: Plane {
                 point: DVec3::ZERO,
                 normal: DVec3::Z,
             },
-            bounds: [lo, hi],
+            bounds: [centre - reach, centre + reach],
             max_snap,
             segment_faces: Vec::new(),
             chain: Chain::default(),
@@ -667,7 +646,8 @@ impl<'a> NearRayDomain<'a> {
     /// from any of its edges but for where it starts: [`SectionDomain::closed_sections`]
     /// reaches it first at its lowest face, from that face's first crossed edge, which is
     /// where it is rotated to.
-    pub fn sections_around(&mut self, plane: &Plane, spheres: &FaceSpheres) -> Vec<SectionCurve> {
+    pub fn sections_around(&mut self, plane: &Plane) -> Vec<SectionCurve> {
+        let spheres = self.spheres;
         self.plane = *plane;
         self.scratch.next_query();
         let o = plane.point;
@@ -706,7 +686,7 @@ impl<'a> NearRayDomain<'a> {
 
     /// Whether face `f` of the mesh is in the domain.
     fn holds(&self, f: u32) -> bool {
-        self.scratch.face_domain[f as usize] == self.mark
+        self.spheres.is_near(f, self.centre, self.radius) && is_proper(self.mesh, f)
     }
 
     /// The snapped signed distance of vertex `v` to the current plane, computed once per
@@ -832,58 +812,52 @@ pub enum JointSections<'a> {
 }
 
 impl<'a> JointSections<'a> {
-    /// The domain of `faces` of `mesh` (in increasing order, those of
-    /// [`FaceSpheres::faces_near`]); faces with a repeated vertex index are left out.
-    /// `scratch` is held by a large domain until it is dropped.
+    /// The domain of the faces of `mesh` (indexed by `spheres`) of
+    /// [`FaceSpheres::faces_near`] `centre` within `radius`; faces with a repeated vertex
+    /// index are left out. `max_snap`: the largest of `vertex_snap`. `scratch` is held by a
+    /// large domain until it is dropped.
     pub fn new(
         mesh: &'a SurfaceMesh,
         topology: &'a Topology,
-        vertex_snap: &'a [f64],
-        faces: Vec<u32>,
+        snap: (&'a [f64], f64),
+        spheres: &'a FaceSpheres,
+        ball: (DVec3, f64),
         scratch: &'a mut DomainScratch,
     ) -> Self {
-        let faces = proper_faces(mesh, faces);
-        if faces.len() < SEGMENT_QUERY_FACES {
-            Self::Scanned(SectionDomain::new(
-                mesh,
-                topology,
-                vertex_snap,
-                faces,
-                scratch,
-            ))
-        } else {
-            Self::NearRay(NearRayDomain::new(
-                mesh,
-                topology,
-                vertex_snap,
-                &faces,
-                scratch,
-            ))
+        let (centre, radius) = ball;
+        let proper = |f| is_proper(mesh, f);
+        match spheres.fewer_faces_near(centre, radius, SEGMENT_QUERY_FACES, proper) {
+            Some(faces) => {
+                Self::Scanned(SectionDomain::new(mesh, topology, snap.0, faces, scratch))
+            }
+            None => Self::NearRay(NearRayDomain::new(
+                mesh, topology, snap, spheres, ball, scratch,
+            )),
         }
     }
 
     /// The closed sections of [`SectionDomain::closed_sections`] that can contain the
     /// plane's point (every one that [`polygon_contains`] of `plane.normal` and
     /// `plane.point` accepts, and perhaps others), each as that list has it (the same
-    /// crossings from the same start), in its order; `spheres` indexes the mesh. A small
-    /// domain lists all its closed sections.
-    pub fn sections_around(&mut self, plane: &Plane, spheres: &FaceSpheres) -> Vec<SectionCurve> {
+    /// crossings from the same start), in its order. A small domain lists all its closed
+    /// sections.
+    pub fn sections_around(&mut self, plane: &Plane) -> Vec<SectionCurve> {
         match self {
             Self::Scanned(domain) => domain.closed_sections(plane),
-            Self::NearRay(domain) => domain.sections_around(plane, spheres),
+            Self::NearRay(domain) => domain.sections_around(plane),
         }
     }
 }
 
 /// `faces` without those with a repeated vertex index (a curve reaching them is open).
 fn proper_faces(mesh: &SurfaceMesh, faces: Vec<u32>) -> Vec<u32> {
-    faces
-        .into_iter()
-        .filter(|&f| {
-            let [a, b, c] = mesh.triangles[f as usize];
-            a != b && b != c && a != c
-        })
-        .collect()
+    faces.into_iter().filter(|&f| is_proper(mesh, f)).collect()
+}
+
+/// Whether face `f` has three distinct vertex indices.
+fn is_proper(mesh: &SurfaceMesh, f: u32) -> bool {
+    let [a, b, c] = mesh.triangles[f as usize];
+    a != b && b != c && a != c
 }
 
 impl SectionCurve {
@@ -1026,7 +1000,7 @@ mod tests {
         }
     }
 
-    /// A scratch given back to its pool is lent again, maps and marks kept; two lent at
+    /// A scratch given back to its pool is lent again, maps and stamps kept; two lent at
     /// once are two.
     #[test]
     fn a_pool_lends_its_scratches_again() {
@@ -1036,11 +1010,11 @@ mod tests {
         {
             let mut scratch = pool.lend();
             scratch.fit(&mesh, &topology);
-            scratch.next_domain();
+            scratch.next_query();
         }
         let (first, second) = (pool.lend(), pool.lend());
         assert_eq!(first.vertex.len(), mesh.vertex_count());
-        assert_eq!(first.domain, 1);
+        assert_eq!(first.query, 1);
         assert!(second.vertex.is_empty());
         drop((first, second));
         assert_eq!(pool.0.lock().unwrap().len(), 2);
@@ -1068,11 +1042,11 @@ mod tests {
         for mesh in &meshes {
             let topology = Topology::new(mesh);
             let snap = vertex_snap_distances(mesh, &topology, 0.01);
+            let max_snap = snap.iter().copied().fold(0.0, f64::max);
             let spheres = FaceSpheres::new(mesh);
             let (mut scratch, mut joint_scratch) = Default::default();
-            // Marks and stamps about to wrap: the maps are cleared on the way.
+            // Stamps about to wrap: the maps are cleared on the way.
             let mut near_scratch = DomainScratch {
-                domain: u32::MAX - 20,
                 query: u32::MAX - 100,
                 ..DomainScratch::default()
             };
@@ -1087,13 +1061,12 @@ mod tests {
                 };
                 let radius = (0.2 + random()) * (hi - lo).length() / 2.0;
                 let faces = spheres.faces_near(point, radius);
-                let proper = proper_faces(mesh, faces.clone());
-                let mut domain =
-                    SectionDomain::new(mesh, &topology, &snap, faces.clone(), &mut scratch);
+                let mut domain = SectionDomain::new(mesh, &topology, &snap, faces, &mut scratch);
+                let (ball, snap) = ((point, radius), (snap.as_slice(), max_snap));
                 let mut near =
-                    NearRayDomain::new(mesh, &topology, &snap, &proper, &mut near_scratch);
+                    NearRayDomain::new(mesh, &topology, snap, &spheres, ball, &mut near_scratch);
                 let mut joint =
-                    JointSections::new(mesh, &topology, &snap, faces, &mut joint_scratch);
+                    JointSections::new(mesh, &topology, snap, &spheres, ball, &mut joint_scratch);
                 for k in 0..8 {
                     let normal = match k {
                         0 => DVec3::Y,
@@ -1111,10 +1084,10 @@ mod tests {
                             .collect()
                     };
                     let all = domain.closed_sections(&plane);
-                    let fast = near.sections_around(&plane, &spheres);
+                    let fast = near.sections_around(&plane);
                     assert!(fast.iter().all(|c| all.contains(c)));
                     assert_eq!(around(&fast), around(&all));
-                    let chosen = joint.sections_around(&plane, &spheres);
+                    let chosen = joint.sections_around(&plane);
                     assert_eq!(around(&chosen), around(&all));
                     compared += around(&all).len();
                     left_out += all.len() - fast.len();

@@ -119,7 +119,7 @@ impl CentreGrid {
     }
 
     /// Faces of the cells x0..=x1 of row (y, z), empty when x0 > x1.
-    fn row(&self, y: i32, z: i32, x0: i32, x1: i32) -> &[u32] {
+    pub(crate) fn row(&self, y: i32, z: i32, x0: i32, x1: i32) -> &[u32] {
         if x0 > x1 {
             return &[];
         }
@@ -324,8 +324,22 @@ impl FaceSpheres {
     /// Faces whose sphere meets the ball of `radius` around `p` (a superset of the faces
     /// that meet the ball), in face order.
     pub fn faces_near(&self, p: DVec3, radius: f64) -> Vec<u32> {
+        self.fewer_faces_near(p, radius, usize::MAX, |_| true)
+            .unwrap_or_default()
+    }
+
+    /// The faces of [`Self::faces_near`] for which `keep` holds, when there are fewer than
+    /// `limit`; `None` at the `limit`-th, found without looking further (a ball around a
+    /// point deep in a large body holds most of the surface).
+    pub fn fewer_faces_near(
+        &self,
+        p: DVec3,
+        radius: f64,
+        limit: usize,
+        keep: impl Fn(u32) -> bool,
+    ) -> Option<Vec<u32>> {
         if self.centres.is_empty() {
-            return Vec::new();
+            return Some(Vec::new());
         }
         let reach = DVec3::splat(radius + self.max_radius);
         let grid = self.grid();
@@ -336,15 +350,36 @@ impl FaceSpheres {
         for z in lo.z..=hi.z {
             for y in lo.y..=hi.y {
                 for &f in grid.row(y, z, lo.x, hi.x) {
-                    let (centre, r) = (self.centres[f as usize], self.radii[f as usize]);
-                    if centre.distance_squared(p) <= (radius + r).powi(2) {
+                    if self.is_near(f, p, radius) && keep(f) {
+                        if faces.len() + 1 >= limit {
+                            return None;
+                        }
                         faces.push(f);
                     }
                 }
             }
         }
         sort_face_indices(&mut faces, self.centres.len());
-        faces
+        Some(faces)
+    }
+
+    /// Whether face `f` is one of [`Self::faces_near`] `p` within `radius`: its sphere
+    /// comes within `radius` of `p`.
+    #[inline]
+    pub fn is_near(&self, f: u32, p: DVec3, radius: f64) -> bool {
+        let (centre, r) = (self.centres[f as usize], self.radii[f as usize]);
+        centre.distance_squared(p) <= (radius + r).powi(2)
+    }
+
+    /// Whether every face is one of [`Self::faces_near`] `p` within `radius`; stops at the
+    /// first that is not.
+    pub fn all_near(&self, p: DVec3, radius: f64) -> bool {
+        (0..self.centres.len() as u32).all(|f| self.is_near(f, p, radius))
+    }
+
+    /// The largest radius of a face's sphere.
+    pub fn max_radius(&self) -> f64 {
+        self.max_radius
     }
 
     /// Appends to `out` the faces whose sphere comes within `radius` of the segment
@@ -1085,6 +1120,12 @@ mod tests {
                 })
                 .collect();
             assert_eq!(spheres.faces_near(p, radius), near, "{p} {radius}");
+            // With a limit and a filter: the kept faces below the limit, none at it.
+            let odd: Vec<u32> = near.iter().copied().filter(|f| f % 2 == 1).collect();
+            for limit in [odd.len().max(1), odd.len() + 1] {
+                let fewer = spheres.fewer_faces_near(p, radius, limit, |f| f % 2 == 1);
+                assert_eq!(fewer, (limit > odd.len()).then(|| odd.clone()), "{limit}");
+            }
         }
     }
 }

@@ -228,6 +228,25 @@ impl BoneTree {
         found
     }
 
+    /// [`Self::within`] when it finds at most `most` segments; `None` at the one after,
+    /// found without looking further (thousands of bones lying along one another are all
+    /// as near to a point beside them).
+    pub fn within_at_most(&self, p: DVec3, radius: f64, most: usize) -> Option<Vec<u32>> {
+        let mut found = Vec::new();
+        let crowded = self.visit_within(p, radius, |key| {
+            if found.len() == most {
+                return ControlFlow::Break(());
+            }
+            found.push(key);
+            ControlFlow::Continue(())
+        });
+        if crowded.is_break() {
+            return None;
+        }
+        found.sort_unstable();
+        Some(found)
+    }
+
     /// A key of a segment within `radius` of `p` for which `admit(key)` holds, `None` when
     /// there is none (the same answer as a scan; which key, when several qualify, is the
     /// first met in the tree's order). Stops at the first: the thousands of sibling bones

@@ -189,6 +189,23 @@ impl BoneIndex {
         }
     }
 
+    /// (parent, child) joints of every bone.
+    pub fn pairs(&self) -> &[(usize, usize)] {
+        &self.pairs
+    }
+
+    /// The bones, increasing, within (1 + `tie`) times the distance of the nearest bone to
+    /// `p` (every bone at that distance, and those a rounding away), when there are at most
+    /// `most` of them; none without bones.
+    pub fn nearest_bones(&self, p: DVec3, tie: f64, most: usize) -> Option<Vec<u32>> {
+        let nearest = self.tree.nearest(p);
+        if nearest.is_finite() {
+            self.tree.within_at_most(p, nearest * (1.0 + tie), most)
+        } else {
+            Some(Vec::new())
+        }
+    }
+
     /// The bones with neither end at `joint` within `radius` of `point`, in bone order.
     pub fn near(&self, joint: usize, point: DVec3, radius: f64) -> Vec<[DVec3; 2]> {
         self.tree

@@ -166,6 +166,51 @@ impl PointGrid {
         found.sort_unstable();
         found
     }
+
+    /// The points of [`Self::within`] whose signed distance n · (q − p) to the plane
+    /// through p with unit normal `normal` lies in `band` (low, high), in the same order,
+    /// visiting only the cells that meet the band: a slab across the ball, not the ball.
+    /// A cell's centre c reaches the band when n · (c − p) is within the cell's whole
+    /// projected extent (cell side × (|n_x| + |n_y| + |n_z|), twice what a point of the
+    /// cell can lie from its centre, a margin for the rounding of the cells' bounds); the
+    /// cells of a row (y, z) that do are one run of x, n · (c − p) being linear in x.
+    pub fn within_band(&self, p: DVec3, radius: f64, normal: DVec3, band: (f64, f64)) -> Vec<u32> {
+        let reach = DVec3::splat(radius * (1.0 + 1e-9));
+        let grid = &self.grid;
+        let (lo, hi) = (grid.cell_of(p - reach), grid.cell_of(p + reach));
+        let margin = grid.cell * normal.abs().element_sum();
+        let (low, high) = (band.0 - margin, band.1 + margin);
+        let step = normal.x * grid.cell;
+        let mut found = Vec::new();
+        for z in lo.z..=hi.z {
+            for y in lo.y..=hi.y {
+                let first =
+                    grid.origin + grid.cell * DVec3::new(0.5, y as f64 + 0.5, z as f64 + 0.5);
+                let at_first = normal.dot(first - p);
+                let (x0, x1) = if step.abs() <= f64::MIN_POSITIVE {
+                    if (low..=high).contains(&at_first) {
+                        (lo.x, hi.x)
+                    } else {
+                        continue;
+                    }
+                } else {
+                    let (a, b) = ((low - at_first) / step, (high - at_first) / step);
+                    let (from, to) = (a.min(b).floor(), a.max(b).ceil());
+                    (
+                        from.max(f64::from(lo.x)) as i32,
+                        to.min(f64::from(hi.x)) as i32,
+                    )
+                };
+                found.extend(grid.row(y, z, x0, x1).iter().copied().filter(|&k| {
+                    let q = self.points[k as usize];
+                    let signed = normal.dot(q - p);
+                    q.distance(p) <= radius && band.0 <= signed && signed <= band.1
+                }));
+            }
+        }
+        found.sort_unstable();
+        found
+    }
 }
 
 /// Visits the items of `grid` in shells of cells around `p` until none can be nearer than

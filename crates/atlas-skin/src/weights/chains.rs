@@ -23,6 +23,12 @@ pub struct RegionTree {
     order: Vec<usize>,
     /// The position of every node in `order`.
     rank: Vec<usize>,
+    /// Every node's depth below the root, and its subtree as an interval of a depth-first
+    /// numbering: node a is an ancestor of (or is) node c when `enter[a]` ≤ `enter[c]` ≤
+    /// `exit[a]`.
+    depth: Vec<usize>,
+    enter: Vec<usize>,
+    exit: Vec<usize>,
 }
 
 impl RegionTree {
@@ -36,10 +42,37 @@ impl RegionTree {
             self.order.extend(self.children[node].iter().copied());
             i += 1;
         }
-        self.rank = vec![0; self.joints.len()];
+        let n = self.joints.len();
+        self.rank = vec![0; n];
+        self.depth = vec![0; n];
         for (rank, &node) in self.order.iter().enumerate() {
             self.rank[node] = rank;
+            if node != 0 {
+                self.depth[node] = self.depth[self.parents[node]] + 1;
+            }
         }
+        // Subtree sizes, children before parents; then each child's interval after its
+        // parent's number, the children in node order.
+        let mut size = vec![1; n];
+        for &node in self.order.iter().skip(1).rev() {
+            size[self.parents[node]] += size[node];
+        }
+        self.enter = vec![0; n];
+        for &node in &self.order {
+            let mut next = self.enter[node] + 1;
+            for &c in &self.children[node] {
+                self.enter[c] = next;
+                next += size[c];
+            }
+        }
+        self.exit = (0..n)
+            .map(|node| self.enter[node] + size[node] - 1)
+            .collect();
+    }
+
+    /// Whether node `a` is node `c` or one of its ancestors.
+    fn holds_below(&self, a: usize, c: usize) -> bool {
+        (self.enter[a]..=self.exit[a]).contains(&self.enter[c])
     }
 }
 
@@ -107,6 +140,8 @@ struct BlendScratch {
     /// The (node, s_c) of the soft sides of one region at one vertex with s_c > 0.
     shares: Vec<(usize, f64)>,
     parents: Vec<usize>,
+    /// The nodes with mass on one node's path to the root.
+    path: Vec<usize>,
 }
 
 /// Steps 2 and 3 for every vertex.
@@ -152,7 +187,8 @@ pub fn blend_vertices(
                     }));
                 scratch.shares.sort_unstable_by_key(|&(node, _)| node);
                 let mass = &mut scratch.mass;
-                share_along_chain(tree, &scratch.shares, omega, mass, &mut scratch.parents);
+                let work = (&mut scratch.parents, &mut scratch.path);
+                share_along_chain(tree, &scratch.shares, omega, mass, work);
                 // The nodes with mass: the root and those with shares, in node order.
                 let nodes = std::iter::once(0).chain(scratch.shares.iter().map(|&(c, _)| c));
                 for c in nodes {
@@ -180,17 +216,20 @@ pub fn blend_vertices(
 /// (module documentation of [`crate::weights`]); `shares` holds (c, s_c) for the nodes
 /// c > 0 with s_c > 0, by increasing node (s_c is 0 at the others). Sets `mass[0]` and
 /// `mass[c]` of those nodes, non-negative and summing to `omega`; every other entry of
-/// `mass` (at least one per node) must be 0 and stays 0. `parents`: working memory.
+/// `mass` (at least one per node) must be 0 and stays 0. `parents`, `path`: working
+/// memory.
 ///
 /// Only the parents of nodes with shares move mass, in the tree's order (a node whose
-/// children have no share passes its mass on unchanged): the cost follows the shares at
-/// the vertex, not the size of the tree (one region with 10,000 soft joints).
+/// children have no share passes its mass on unchanged), and only the root and the nodes
+/// with shares hold mass ([`take_pool`]): the cost follows the shares at the vertex, not
+/// the size or the depth of the tree (one region with 10,000 soft joints; a chain of
+/// 3,670 soft joints in one region walked its whole length per vertex, issue 45).
 fn share_along_chain(
     tree: &RegionTree,
     shares: &[(usize, f64)],
     omega: f64,
     mass: &mut [f64],
-    parents: &mut Vec<usize>,
+    (parents, path): (&mut Vec<usize>, &mut Vec<usize>),
 ) {
     mass[0] = omega;
     parents.clear();
@@ -203,7 +242,7 @@ fn share_along_chain(
         if total <= 0.0 {
             continue;
         }
-        let pool = take_pool(tree, node, total, mass);
+        let pool = take_pool(tree, node, total, shares, mass, path);
         for &(c, share) in children {
             mass[c] = pool * share / total.max(1.0);
         }
@@ -211,18 +250,35 @@ fn share_along_chain(
 }
 
 /// The mass the children of `node` share, whose shares sum to `total`: the mass of the
-/// whole chain from the root to `node`, each of whose masses keeps 1 − min(total, 1).
-fn take_pool(tree: &RegionTree, node: usize, total: f64, mass: &mut [f64]) -> f64 {
+/// whole chain from the root to `node`, each of whose masses keeps 1 − min(total, 1),
+/// summed from `node` up. Only the root and the nodes of `shares` hold mass (the rest are
+/// 0, and adding or scaling a 0 changes nothing), so only those on the chain are visited,
+/// deepest first: the same sum in the same order as the walk up every node of the chain
+/// (`take_pool_by_walk`, the reference of the tests). `path`: working memory.
+fn take_pool(
+    tree: &RegionTree,
+    node: usize,
+    total: f64,
+    shares: &[(usize, f64)],
+    mass: &mut [f64],
+    path: &mut Vec<usize>,
+) -> f64 {
+    path.clear();
+    path.extend(
+        shares
+            .iter()
+            .map(|&(c, _)| c)
+            .filter(|&c| tree.holds_below(c, node)),
+    );
+    path.push(0);
+    path.sort_unstable_by_key(|&a| std::cmp::Reverse(tree.depth[a]));
+    path.dedup();
     let mut pool = 0.0;
-    let mut a = node;
-    loop {
+    for &a in path.iter() {
         pool += mass[a];
         mass[a] *= 1.0 - total.min(1.0);
-        if a == 0 {
-            return pool;
-        }
-        a = tree.parents[a];
     }
+    pool
 }
 
 #[cfg(test)]
@@ -240,7 +296,7 @@ mod tests {
             if total <= 0.0 {
                 continue;
             }
-            let pool = take_pool(tree, node, total, &mut mass);
+            let pool = take_pool_by_walk(tree, node, total, &mut mass);
             for &c in &tree.children[node] {
                 mass[c] = pool * share(c) / total.max(1.0);
             }
@@ -248,13 +304,33 @@ mod tests {
         mass
     }
 
-    /// Random trees (chains, fans of siblings, mixtures) and random shares, most of them 0:
-    /// the same masses, to the bit, as the reference, and the working masses left at 0.
+    /// [`take_pool`] by its definition: every node from `node` up to the root.
+    fn take_pool_by_walk(tree: &RegionTree, node: usize, total: f64, mass: &mut [f64]) -> f64 {
+        let mut pool = 0.0;
+        let mut a = node;
+        loop {
+            pool += mass[a];
+            mass[a] *= 1.0 - total.min(1.0);
+            if a == 0 {
+                return pool;
+            }
+            a = tree.parents[a];
+        }
+    }
+
+    /// Random trees (chains, fans of siblings, mixtures; a few thousands of nodes deep) and
+    /// random shares, most of them 0: the same masses, to the bit, as the reference, and
+    /// the working masses left at 0.
     #[test]
     fn sparse_chain_sharing_gives_the_reference_masses() {
         let mut rng = SplitMix64::new(5);
         for case in 0..200 {
-            let n = 1 + (rng.next_f64() * 40.0) as usize;
+            // Every 50th a chain or a tree thousands of nodes deep.
+            let n = if case % 50 < 2 {
+                3000
+            } else {
+                1 + (rng.next_f64() * 40.0) as usize
+            };
             let mut tree = RegionTree {
                 joints: (0..n as u32).collect(),
                 softs: (0..n.saturating_sub(1)).collect(),
@@ -291,7 +367,8 @@ mod tests {
                 .map(|c| (c, all_shares[c]))
                 .collect();
             let mut mass = vec![0.0; n + 3];
-            share_along_chain(&tree, &shares, omega, &mut mass, &mut Vec::new());
+            let work = (&mut Vec::new(), &mut Vec::new());
+            share_along_chain(&tree, &shares, omega, &mut mass, work);
             for c in 0..n {
                 assert_eq!(
                     mass[c].to_bits(),

@@ -287,14 +287,19 @@ impl<'a> NearVertices<'a> {
         Self::Grid(PointGrid::new(positions))
     }
 
-    fn within(&self, p: DVec3, radius: f64) -> Vec<u32> {
+    /// The vertices q within `radius` of `p` whose signed distance n · (q − p) to the plane
+    /// through p with unit normal `normal` lies in `band` (low, high), increasing.
+    fn within_band(&self, p: DVec3, radius: f64, normal: DVec3, band: (f64, f64)) -> Vec<u32> {
         match self {
             Self::Scan(positions) => (0u32..)
                 .zip(positions.iter())
-                .filter(|&(_, &q)| point_segment_distance(p, q, q) <= radius)
+                .filter(|&(_, &q)| {
+                    let signed = normal.dot(q - p);
+                    q.distance(p) <= radius && band.0 <= signed && signed <= band.1
+                })
                 .map(|(v, _)| v)
                 .collect(),
-            Self::Grid(grid) => grid.within(p, radius),
+            Self::Grid(grid) => grid.within_band(p, radius, normal, band),
         }
     }
 
@@ -366,9 +371,8 @@ fn child_side(
     // flood's result does not depend on their order).
     let seed_radius = b.diameter.max(half_width);
     let near_band = |radius: f64| {
-        let mut near = seeds.vertices.within(b.point, radius);
-        near.retain(|&v| signed(v as usize) <= half_width);
-        near
+        let band = (-half_width, half_width);
+        seeds.vertices.within_band(b.point, radius, b.normal, band)
     };
     for v in near_band(seed_radius) {
         visit(v, &mut queue);
@@ -443,7 +447,9 @@ mod tests {
     }
 
     /// The scan of the vertices finds what the grid of the vertices finds, at radii of 0, at
-    /// a vertex's exact distance (on the ball's boundary), just inside it and at random.
+    /// a vertex's exact distance (on the ball's boundary), just inside it and at random,
+    /// in bands across planes at random: unbounded, around the point, and ending at a
+    /// vertex's exact signed distance, just short of it and past it.
     #[test]
     fn the_scan_finds_the_vertices_and_the_nearest_distance_the_grid_finds() {
         let mut rng = SplitMix64::new(3);
@@ -455,16 +461,42 @@ mod tests {
             (&scan, &grid),
             (NearVertices::Scan(_), NearVertices::Grid(_))
         ));
+        let everywhere = (f64::NEG_INFINITY, f64::INFINITY);
+        let (mut banded, mut left_out) = (0, 0);
         for (k, &vertex) in positions.iter().enumerate().take(50) {
             let p = point();
+            let normal = match k % 5 {
+                0 => DVec3::X,
+                _ => (point() - DVec3::splat(0.5)).normalize(),
+            };
             assert_eq!(scan.nearest(p), grid.nearest(p), "nearest to {p}");
             let exact = p.distance(vertex);
-            for radius in [0.0, exact, exact * (1.0 - 1e-12), 0.3 * point().x] {
-                let found = scan.within(p, radius);
-                assert_eq!(found, grid.within(p, radius), "{p} within {radius}");
+            let at = normal.dot(vertex - p);
+            for radius in [0.0, exact, exact * (1.0 - 1e-12), 0.3 * point().x, 2.0] {
+                let found = scan.within_band(p, radius, normal, everywhere);
+                let from_grid = grid.within_band(p, radius, normal, everywhere);
+                assert_eq!(found, from_grid, "{p} within {radius}");
                 assert_eq!(found.contains(&(k as u32)), radius >= exact);
+                let short = at - at.abs() * 1e-12;
+                for band in [(-0.1, 0.1), (at, at + 0.05), (at - 0.05, at), (-1.0, short)] {
+                    let expected: Vec<u32> = found
+                        .iter()
+                        .copied()
+                        .filter(|&v| {
+                            (band.0..=band.1).contains(&normal.dot(positions[v as usize] - p))
+                        })
+                        .collect();
+                    assert_eq!(scan.within_band(p, radius, normal, band), expected);
+                    assert_eq!(grid.within_band(p, radius, normal, band), expected);
+                    banded += expected.len();
+                    left_out += found.len() - expected.len();
+                }
             }
         }
-        assert_eq!(scan.within(positions[7], 0.0), [7]);
+        assert!(banded > 100 && left_out > 100, "{banded} {left_out}");
+        assert_eq!(
+            scan.within_band(positions[7], 0.0, DVec3::Y, everywhere),
+            [7]
+        );
     }
 }
