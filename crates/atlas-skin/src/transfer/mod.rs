@@ -43,10 +43,12 @@
 pub mod closest_point;
 pub mod cotangent;
 pub mod inpaint;
+pub mod row_scratch;
 pub mod smooth;
 
 pub use closest_point::TransferSource;
 
+use crate::mesh::spatial_index::morton_order;
 use crate::mesh::weld::{DEFAULT_WELD_TOLERANCE, UNREFERENCED};
 use crate::mesh::{weld, Topology};
 use atlas_skin_runtime::VertexWeights;
@@ -254,23 +256,28 @@ pub fn transfer_weights(
     let distance = params.distance * source_size;
     let min_cos = params.angle_degrees.to_radians().cos();
 
-    // §3.1: the closest points, in chunks whose queries start from the previous vertex's
-    // face (neighbouring vertices in the stored order are mostly near each other).
-    let closest: Vec<Closest> = mesh
-        .positions
+    // §3.1: the closest points, the vertices taken in Morton order (near each other in
+    // space, whatever the stored order), in chunks whose queries start from the previous
+    // vertex's face: the same points, found sooner (FaceSpheres::nearest_point_from).
+    let order = morton_order(&mesh.positions);
+    let in_order: Vec<Closest> = order
         .par_chunks(1024)
         .flat_map_iter(|chunk| {
             let mut hint = None;
             chunk
                 .iter()
-                .map(|&p| {
-                    let c = source.closest(p, hint);
+                .map(|&v| {
+                    let c = source.closest(mesh.positions[v as usize], hint);
                     hint = Some(c.point.face);
                     c
                 })
                 .collect::<Vec<_>>()
         })
         .collect();
+    let mut closest = vec![in_order[0]; in_order.len()];
+    for (&v, c) in order.iter().zip(&in_order) {
+        closest[v as usize] = *c;
+    }
     let nearest = closest
         .iter()
         .map(|c| c.point.distance)
@@ -363,6 +370,7 @@ pub fn transfer_weights(
             &topology,
             &zone,
             &mut rows,
+            source.joint_count,
             params.smooth_iterations,
             params.smooth_alpha,
         );
