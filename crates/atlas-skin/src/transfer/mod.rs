@@ -307,7 +307,7 @@ pub fn transfer_weights(
         topology.component_count,
         (0..n).map(|v| (topology.vertex_component[v] as usize, v as u32)),
     );
-    let operators = Operators::new(mesh);
+    let operators = Operators::new(mesh, &topology);
     let mut sources = vec![VertexSource::Matched; n];
     let mut pieces = Vec::with_capacity(topology.component_count);
     let mut slot = vec![FIXED; n];

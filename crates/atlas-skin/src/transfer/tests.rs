@@ -216,7 +216,7 @@ fn a_piece_without_a_match_is_bound_where_it_comes_nearest() {
 fn the_sparse_solve_equals_the_dense_reference() {
     let (positions, triangles) = tube(0.27, 0.12, 0.4, 0.9, 24, 8);
     let welded = weld(&positions, &triangles, DEFAULT_WELD_TOLERANCE);
-    let ops = Operators::new(&welded.mesh);
+    let ops = Operators::new(&welded.mesh, &Topology::new(&welded.mesh));
     let n = welded.mesh.vertex_count();
     // Fixed: the bottom and top rings with three joints varying around; unknown: the rest.
     let fixed_rows: Vec<Vec<(u32, f64)>> = (0..n)
