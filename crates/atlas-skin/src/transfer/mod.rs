@@ -11,12 +11,13 @@
 //!
 //! 1. **Closest point matching** (§3.1, [`closest_point`]): every vertex p finds the nearest
 //!    point q of the source surface; it is matched when |p − q| ≤ d and the angle between
-//!    its normal and the source's interpolated normal at q is at most θ (or, flipped
-//!    normals accepted, at least 180° − θ), and then takes the source's weights
-//!    interpolated at q: w(p) = u w(a) + v w(b) + w w(c) over q's face abc. d is
-//!    [`TransferParams::distance`] times the source's bounding-box diagonal (the paper's
-//!    5%, of the target's diagonal in its reference implementation; here of the source's,
-//!    so that a small hat and a long coat are judged alike), θ = 30° by default.
+//!    its normal and the source's interpolated normal at q is at most θ (or, with
+//!    [`TransferParams::flipped_normals`], at least 180° − θ), and then takes the
+//!    source's weights interpolated at q: w(p) = u w(a) + v w(b) + w w(c) over q's face
+//!    abc. d is [`TransferParams::distance`] times the source's bounding-box diagonal
+//!    (the paper's 5%, of the target's diagonal in its reference implementation; here of
+//!    the source's, so that a small hat and a long coat are judged alike), θ = 30° by
+//!    default.
 //! 2. **Inpainting** (§3.2, [`inpaint`]): the other vertices' weights minimise
 //!    tr(Wᵀ Q W), Q = −L + L M⁻¹ L (cotangent Laplacian L, Voronoi mass M:
 //!    [`cotangent`]), with the matched rows fixed: Q_uu W_u = −Q_uk W_k, solved by a
@@ -107,7 +108,11 @@ pub struct TransferParams {
     pub distance: f64,
     /// Matching angle θ between normals, in degrees (0 to 90).
     pub angle_degrees: f64,
-    /// Accept a source normal pointing the opposite way (single-sided garments).
+    /// Also match where the target's normal points against the source's (within θ of the
+    /// opposite way): for a single-sided garment wound the other way. Off by default: a
+    /// vertex facing the source across a gap (the inner side of a sleeve facing the
+    /// chest, teeth and eyes inside the head) would take the weights of a surface it does
+    /// not lie on.
     pub flipped_normals: bool,
     /// Rounds of smoothing near the inpainted vertices (0: none).
     pub smooth_iterations: usize,
@@ -120,7 +125,7 @@ impl Default for TransferParams {
         Self {
             distance: 0.05,
             angle_degrees: 30.0,
-            flipped_normals: true,
+            flipped_normals: false,
             smooth_iterations: 10,
             smooth_alpha: 0.2,
         }
