@@ -637,7 +637,7 @@ fn sort_by_code(mut keyed: Vec<(u64, u32)>) -> Vec<(u64, u32)> {
 
 /// The indices of `points` along a Morton (Z-order) curve of their bounding box (ties by
 /// index): points near each other in space come mostly near each other in the order.
-/// O(n) ([`sort_by_code`]).
+/// O(n) (a radix sort of the codes).
 pub fn morton_order(points: &[DVec3]) -> Vec<u32> {
     let (lo, hi) = crate::geometry::bounding_box(points);
     let scale = MORTON_CELLS / (hi - lo).max(DVec3::splat(f64::MIN_POSITIVE));
@@ -997,6 +997,17 @@ mod tests {
         assert_eq!(code(3, 5, 6), 0b110_101_011);
         let top = (1 << 21) - 1;
         assert_eq!(code(top, top, top), (1u64 << 63) - 1);
+    }
+
+    /// The corners of a unit cube, listed backwards, come in Z-order: x fastest, then y,
+    /// then z (a corner's code is x + 2y + 4z).
+    #[test]
+    fn morton_order_visits_a_cube_in_z_order() {
+        let corners: Vec<DVec3> = (0..8)
+            .rev()
+            .map(|k| DVec3::new((k & 1) as f64, (k >> 1 & 1) as f64, (k >> 2) as f64))
+            .collect();
+        assert_eq!(morton_order(&corners), [7, 6, 5, 4, 3, 2, 1, 0]);
     }
 
     #[test]
