@@ -76,8 +76,8 @@ class OBJECT_OT_transfer_atlas_skin(bpy.types.Operator):
     )
     flipped_normals: BoolProperty(
         name="Flipped Normals",
-        description="Also copy where the normals point opposite ways (single-sided garments)",
-        default=True,
+        description="Also copy where the normals point opposite ways (a single-sided garment wound the other way)",
+        default=False,
     )
     smooth_iterations: IntProperty(
         name="Smoothing",

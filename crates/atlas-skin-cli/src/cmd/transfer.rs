@@ -47,10 +47,11 @@ pub struct Args {
     /// Matching angle between normals, in degrees.
     #[arg(long, value_name = "DEG", default_value_t = TransferParams::default().angle_degrees)]
     pub angle: f64,
-    /// Refuse a match whose source normal points the opposite way (by default accepted:
-    /// single-sided garments may be wound either way).
+    /// Also match where a target vertex's normal points against the source's (a
+    /// single-sided garment wound the other way); by default refused: such a vertex faces
+    /// the source across a gap.
     #[arg(long)]
-    pub no_flipped_normals: bool,
+    pub flipped_normals: bool,
     /// Rounds of smoothing near the inpainted vertices (0: none).
     #[arg(long, value_name = "N", default_value_t = TransferParams::default().smooth_iterations,
           value_parser = crate::counts::count_between(0, 10_000))]
@@ -71,7 +72,7 @@ pub fn run(args: Args) -> Result<()> {
         params: TransferParams {
             distance: args.distance,
             angle_degrees: args.angle,
-            flipped_normals: !args.no_flipped_normals,
+            flipped_normals: args.flipped_normals,
             smooth_iterations: args.smooth,
             smooth_alpha: args.smooth_alpha,
         },

@@ -583,19 +583,12 @@ impl FaceBvh {
     fn new(mesh: &SurfaceMesh, centres: &[DVec3]) -> Self {
         let (lo, hi) = mesh.bounding_box();
         let pad = 1e-9 * (hi - lo).max_element().max(f64::MIN_POSITIVE);
-        let (centre_lo, centre_hi) = crate::geometry::bounding_box(centres);
-        let scale = MORTON_CELLS / (centre_hi - centre_lo).max(DVec3::splat(f64::MIN_POSITIVE));
-        let keyed: Vec<(u64, u32)> = centres
-            .iter()
-            .enumerate()
-            .map(|(f, c)| (morton_code(((*c - centre_lo) * scale).as_uvec3()), f as u32))
-            .collect();
         let mut bvh = Self {
             // At most F nodes, so the list never grows (grown, it was copied once): a range
             // of more than LEAF_FACES faces is halved into two of at least 2, so a tree of
             // F ≥ 2 faces has at most F / 2 leaves and F − 1 nodes.
             nodes: Vec::with_capacity(centres.len()),
-            faces: sort_by_code(keyed).into_iter().map(|(_, f)| f).collect(),
+            faces: morton_order(centres),
             pad,
         };
         if !bvh.faces.is_empty() {
@@ -675,6 +668,20 @@ fn sort_by_code(mut keyed: Vec<(u64, u32)>) -> Vec<(u64, u32)> {
         std::mem::swap(&mut keyed, &mut other);
     }
     keyed
+}
+
+/// The indices of `points` along a Morton (Z-order) curve of their bounding box (ties by
+/// index): points near each other in space come mostly near each other in the order.
+/// O(n) (a radix sort of the codes).
+pub fn morton_order(points: &[DVec3]) -> Vec<u32> {
+    let (lo, hi) = crate::geometry::bounding_box(points);
+    let scale = MORTON_CELLS / (hi - lo).max(DVec3::splat(f64::MIN_POSITIVE));
+    let keyed: Vec<(u64, u32)> = points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (morton_code(((*p - lo) * scale).as_uvec3()), i as u32))
+        .collect();
+    sort_by_code(keyed).into_iter().map(|(_, i)| i).collect()
 }
 
 /// Cells per axis of the Morton code's grid (21 bits per axis fill 63 bits).
@@ -1025,6 +1032,17 @@ mod tests {
         assert_eq!(code(3, 5, 6), 0b110_101_011);
         let top = (1 << 21) - 1;
         assert_eq!(code(top, top, top), (1u64 << 63) - 1);
+    }
+
+    /// The corners of a unit cube, listed backwards, come in Z-order: x fastest, then y,
+    /// then z (a corner's code is x + 2y + 4z).
+    #[test]
+    fn morton_order_visits_a_cube_in_z_order() {
+        let corners: Vec<DVec3> = (0..8)
+            .rev()
+            .map(|k| DVec3::new((k & 1) as f64, (k >> 1 & 1) as f64, (k >> 2) as f64))
+            .collect();
+        assert_eq!(morton_order(&corners), [7, 6, 5, 4, 3, 2, 1, 0]);
     }
 
     #[test]

@@ -28,6 +28,7 @@
 //! densely.
 
 use super::cotangent::Operators;
+use super::row_scratch::RowScratch;
 use faer::linalg::solvers::Solve;
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, Side};
@@ -150,42 +151,6 @@ impl System<'_> {
             .flat_map(|ui| (0..self.columns).map(move |c| (ui, c)))
             .map(|(ui, c)| rhs[(ui, c)])
             .collect())
-    }
-}
-
-/// A sparse row accumulated in a dense array: the values and which entries were set.
-struct RowScratch {
-    values: Vec<f64>,
-    set: Vec<bool>,
-    touched: Vec<u32>,
-}
-
-impl RowScratch {
-    fn new(n: usize) -> Self {
-        Self {
-            values: vec![0.0; n],
-            set: vec![false; n],
-            touched: Vec::new(),
-        }
-    }
-
-    fn add(&mut self, j: u32, value: f64) {
-        if !self.set[j as usize] {
-            self.set[j as usize] = true;
-            self.touched.push(j);
-        }
-        self.values[j as usize] += value;
-    }
-
-    /// Appends the entries set, ascending, and clears them.
-    fn drain_into(&mut self, out: &mut Vec<(u32, f64)>) {
-        self.touched.sort_unstable();
-        for &j in &self.touched {
-            out.push((j, self.values[j as usize]));
-            self.values[j as usize] = 0.0;
-            self.set[j as usize] = false;
-        }
-        self.touched.clear();
     }
 }
 

@@ -11,12 +11,13 @@
 //!
 //! 1. **Closest point matching** (§3.1, [`closest_point`]): every vertex p finds the nearest
 //!    point q of the source surface; it is matched when |p − q| ≤ d and the angle between
-//!    its normal and the source's interpolated normal at q is at most θ (or, flipped
-//!    normals accepted, at least 180° − θ), and then takes the source's weights
-//!    interpolated at q: w(p) = u w(a) + v w(b) + w w(c) over q's face abc. d is
-//!    [`TransferParams::distance`] times the source's bounding-box diagonal (the paper's
-//!    5%, of the target's diagonal in its reference implementation; here of the source's,
-//!    so that a small hat and a long coat are judged alike), θ = 30° by default.
+//!    its normal and the source's interpolated normal at q is at most θ (or, with
+//!    [`TransferParams::flipped_normals`], at least 180° − θ), and then takes the
+//!    source's weights interpolated at q: w(p) = u w(a) + v w(b) + w w(c) over q's face
+//!    abc. d is [`TransferParams::distance`] times the source's bounding-box diagonal
+//!    (the paper's 5%, of the target's diagonal in its reference implementation; here of
+//!    the source's, so that a small hat and a long coat are judged alike), θ = 30° by
+//!    default.
 //! 2. **Inpainting** (§3.2, [`inpaint`]): the other vertices' weights minimise
 //!    tr(Wᵀ Q W), Q = −L + L M⁻¹ L (cotangent Laplacian L, Voronoi mass M:
 //!    [`cotangent`]), with the matched rows fixed: Q_uu W_u = −Q_uk W_k, solved by a
@@ -43,10 +44,12 @@
 pub mod closest_point;
 pub mod cotangent;
 pub mod inpaint;
+pub mod row_scratch;
 pub mod smooth;
 
 pub use closest_point::TransferSource;
 
+use crate::mesh::spatial_index::morton_order;
 use crate::mesh::weld::{DEFAULT_WELD_TOLERANCE, UNREFERENCED};
 use crate::mesh::{weld, Topology};
 use atlas_skin_runtime::VertexWeights;
@@ -105,7 +108,11 @@ pub struct TransferParams {
     pub distance: f64,
     /// Matching angle θ between normals, in degrees (0 to 90).
     pub angle_degrees: f64,
-    /// Accept a source normal pointing the opposite way (single-sided garments).
+    /// Also match where the target's normal points against the source's (within θ of the
+    /// opposite way): for a single-sided garment wound the other way. Off by default: a
+    /// vertex facing the source across a gap (the inner side of a sleeve facing the
+    /// chest, teeth and eyes inside the head) would take the weights of a surface it does
+    /// not lie on.
     pub flipped_normals: bool,
     /// Rounds of smoothing near the inpainted vertices (0: none).
     pub smooth_iterations: usize,
@@ -118,7 +125,7 @@ impl Default for TransferParams {
         Self {
             distance: 0.05,
             angle_degrees: 30.0,
-            flipped_normals: true,
+            flipped_normals: false,
             smooth_iterations: 10,
             smooth_alpha: 0.2,
         }
@@ -254,23 +261,28 @@ pub fn transfer_weights(
     let distance = params.distance * source_size;
     let min_cos = params.angle_degrees.to_radians().cos();
 
-    // §3.1: the closest points, in chunks whose queries start from the previous vertex's
-    // face (neighbouring vertices in the stored order are mostly near each other).
-    let closest: Vec<Closest> = mesh
-        .positions
+    // §3.1: the closest points, the vertices taken in Morton order (near each other in
+    // space, whatever the stored order), in chunks whose queries start from the previous
+    // vertex's face: the same points, found sooner (FaceSpheres::nearest_point_from).
+    let order = morton_order(&mesh.positions);
+    let in_order: Vec<Closest> = order
         .par_chunks(1024)
         .flat_map_iter(|chunk| {
             let mut hint = None;
             chunk
                 .iter()
-                .map(|&p| {
-                    let c = source.closest(p, hint);
+                .map(|&v| {
+                    let c = source.closest(mesh.positions[v as usize], hint);
                     hint = Some(c.point.face);
                     c
                 })
                 .collect::<Vec<_>>()
         })
         .collect();
+    let mut closest = vec![in_order[0]; in_order.len()];
+    for (&v, c) in order.iter().zip(&in_order) {
+        closest[v as usize] = *c;
+    }
     let nearest = closest
         .iter()
         .map(|c| c.point.distance)
@@ -300,7 +312,7 @@ pub fn transfer_weights(
         topology.component_count,
         (0..n).map(|v| (topology.vertex_component[v] as usize, v as u32)),
     );
-    let operators = Operators::new(mesh);
+    let operators = Operators::new(mesh, &topology);
     let mut sources = vec![VertexSource::Matched; n];
     let mut pieces = Vec::with_capacity(topology.component_count);
     let mut slot = vec![FIXED; n];
@@ -363,6 +375,7 @@ pub fn transfer_weights(
             &topology,
             &zone,
             &mut rows,
+            source.joint_count,
             params.smooth_iterations,
             params.smooth_alpha,
         );

@@ -142,14 +142,15 @@ fn rows_sum_to_one_and_seam_copies_agree() {
 
 /// The reference implementation's example: constant weights (0.3, 0.7) on a sphere, a
 /// plane above it only partly matched; the inpainted vertices get exactly the constant
-/// (Q annihilates constants), smoothed or not.
+/// (Q annihilates constants), smoothed or not. The plane wound facing down matches only
+/// with flipped normals accepted; without, it matches nowhere and is bound whole.
 #[test]
 fn constant_weights_are_carried_exactly() {
     let sphere = uv_sphere(1.0, 24, 48);
     let positions: Vec<Vec3> = sphere.positions.iter().map(|p| p.as_vec3()).collect();
     let weights = VertexWeights::from_rows(positions.iter().map(|_| vec![(0, 0.3), (1, 0.7)]));
     let source = TransferSource::new(&positions, &sphere.triangles, &weights, 2).unwrap();
-    // A 3 × 3 plane at z = 1.02 facing +Z, 31 × 31 vertices.
+    // A 3 × 3 plane at z = 1.02, 31 × 31 vertices.
     let n = 31u32;
     let plane: Vec<Vec3> = (0..n * n)
         .map(|v| {
@@ -168,7 +169,20 @@ fn constant_weights_are_carried_exactly() {
         |y, x| y as u32 * n + x as u32,
         &mut triangles,
     );
+    // quad_grid winds the plane facing −Z: turned to face +Z, away from the sphere.
+    let facing_down = triangles.clone();
+    for t in &mut triangles {
+        t.swap(1, 2);
+    }
+    let down = transfer_weights(&source, &plane, &facing_down, &TransferParams::default());
+    assert_eq!(down.unwrap().counts.nearest, plane.len());
+    let flipped = TransferParams {
+        flipped_normals: true,
+        ..TransferParams::default()
+    };
+    let down = transfer_weights(&source, &plane, &facing_down, &flipped).unwrap();
     let result = transfer_weights(&source, &plane, &triangles, &TransferParams::default()).unwrap();
+    assert_eq!(down.counts, result.counts);
     assert!(result.counts.matched > 0 && result.counts.inpainted > result.counts.matched);
     for v in 0..plane.len() {
         let row: Vec<(u32, f32)> = result.weights.row(v).collect();
@@ -216,7 +230,7 @@ fn a_piece_without_a_match_is_bound_where_it_comes_nearest() {
 fn the_sparse_solve_equals_the_dense_reference() {
     let (positions, triangles) = tube(0.27, 0.12, 0.4, 0.9, 24, 8);
     let welded = weld(&positions, &triangles, DEFAULT_WELD_TOLERANCE);
-    let ops = Operators::new(&welded.mesh);
+    let ops = Operators::new(&welded.mesh, &Topology::new(&welded.mesh));
     let n = welded.mesh.vertex_count();
     // Fixed: the bottom and top rings with three joints varying around; unknown: the rest.
     let fixed_rows: Vec<Vec<(u32, f64)>> = (0..n)
