@@ -137,51 +137,24 @@ mod tests {
     use super::*;
     use crate::fixtures::shapes::quad_grid;
 
-    /// The operators as first written (the reference [`Operators::new`] is compared
-    /// with): every face's cotangents as entries (i, j, cot), sorted and merged.
+    /// The operators assembled as first written (the reference [`Operators::new`]'s
+    /// summing on the edges is compared with): every face's cotangents as entries
+    /// (i, j, cot), sorted and merged.
     fn by_sorting(mesh: &SurfaceMesh) -> Operators {
         let n = mesh.vertex_count();
         let mut mass = vec![0.0; n];
         let mut entries: Vec<(u32, u32, f64)> = Vec::with_capacity(6 * mesh.triangle_count());
         for (f, t) in mesh.triangles.iter().enumerate() {
-            let p = mesh.corners(f);
-            let double_area = mesh.scaled_normal(f).length();
-            let longest = (0..3)
-                .map(|i| p[i].distance_squared(p[(i + 1) % 3]))
-                .fold(0.0, f64::max);
-            if double_area.is_nan()
-                || double_area <= FLAT * longest
-                || t[0] == t[1]
-                || t[1] == t[2]
-                || t[0] == t[2]
-            {
+            let Some(cots) = face_cotangents(mesh, f) else {
                 continue;
-            }
-            // Corner i's angle lies between the edges to the two other corners.
-            let cots: [f64; 3] = std::array::from_fn(|i| {
-                let (j, k) = ((i + 1) % 3, (i + 2) % 3);
-                cot(p[j] - p[i], p[k] - p[i])
-            });
+            };
             for (i, &cot_i) in cots.iter().enumerate() {
                 let (j, k) = ((i + 1) % 3, (i + 2) % 3);
                 // The edge jk is opposite corner i.
                 entries.push((t[j], t[k], cot_i));
                 entries.push((t[k], t[j], cot_i));
             }
-            let area = 0.5 * double_area;
-            let obtuse = (0..3).find(|&i| cots[i] < 0.0);
-            for i in 0..3 {
-                let (j, k) = ((i + 1) % 3, (i + 2) % 3);
-                mass[t[i] as usize] += match obtuse {
-                    None => {
-                        (p[i].distance_squared(p[j]) * cots[k]
-                            + p[i].distance_squared(p[k]) * cots[j])
-                            / 8.0
-                    }
-                    Some(o) if o == i => area / 2.0,
-                    Some(_) => area / 4.0,
-                };
-            }
+            add_face_mass(mesh, f, t, &cots, &mut mass);
         }
         entries.sort_unstable_by_key(|&(i, j, _)| (i, j));
         let mut merged: Vec<(u32, u32, f64)> = Vec::with_capacity(entries.len());
