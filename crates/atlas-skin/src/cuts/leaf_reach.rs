@@ -9,10 +9,10 @@
 //! only the vertices whose nearest bones include a bone at the leaf are asked
 //! ([`LeafReach`]), each vertex under its nearest bones, found once for all leaves: the
 //! work over all leaves is bounded by the surface's vertices, where asking the vertices of
-//! the faces within 2 reach of p ([`leaf_reaches_in_ball`], the reference) cost a leaf deep
+//! the faces within 2 reach of p (`leaf_reaches_in_ball`, the reference) cost a leaf deep
 //! in a blob most of the surface (a tree of 4,096 leaves spread through a sphere of
 //! 100,000 vertices: two thirds of its decomposition, issue 45). A vertex with more than
-//! [`MOST_NEAREST`] nearest bones (bones lying along one another: thousands of siblings of
+//! `MOST_NEAREST` nearest bones (bones lying along one another: thousands of siblings of
 //! one root along a tube are all as near to each vertex of the tube) is listed under none
 //! and asked by every leaf whose ball holds it, from a grid of those vertices, as the
 //! reference asks every vertex.
@@ -50,7 +50,7 @@ pub struct LeafReach<'a> {
     bones_at: Rows<u32>,
     /// The vertices, increasing, of each bone.
     vertices_of: Rows<u32>,
-    /// The vertices of some face with more than [`MOST_NEAREST`] nearest bones,
+    /// The vertices of some face with more than `MOST_NEAREST` nearest bones,
     /// increasing, and a grid of their positions (when there are some).
     crowded: Vec<u32>,
     crowded_grid: Option<PointGrid>,
