@@ -10,10 +10,8 @@
 // shown with the skeleton, the boundaries and the help line hidden, coloured by region
 // (each vertex by its dominant joint); fails when a report does not load or the pose
 // leaves its picture unchanged.
-import { chromium } from 'playwright-core';
-import { mkdtempSync, rmSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import { join, resolve } from 'node:path';
+import { launchChromium } from './chromium.mjs';
+import { resolve } from 'node:path';
 import { pathToFileURL } from 'node:url';
 
 const [beforePath, afterPath, outPath, poseJson] = process.argv.slice(2);
@@ -24,17 +22,7 @@ if (!beforePath || !afterPath || !outPath || !poseJson) {
 const pose = JSON.parse(poseJson);
 const changed = (a, b) => a.filter((v, i) => Math.abs(v - b[i]) > 8).length / a.length;
 
-const userDataDir = mkdtempSync(join(tmpdir(), 'atlas-skin-chromium-'));
-const context = await chromium.launchPersistentContext(userDataDir, {
-  executablePath: '/usr/bin/chromium',
-  headless: true,
-  viewport: { width: 1280, height: 800 },
-  args: [
-    '--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-    '--disable-background-networking', '--disable-component-update', '--disable-sync',
-    '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-  ],
-});
+const { context, close } = await launchChromium();
 
 // The posed view of one report, as a PNG of the canvas.
 async function posedView(page, path) {
@@ -82,8 +70,7 @@ try {
 } catch (error) {
   failed = error;
 } finally {
-  await context.close();
-  rmSync(userDataDir, { recursive: true, force: true });
+  await close();
 }
 if (failed) {
   console.error(String(failed && failed.stack ? failed.stack : failed));

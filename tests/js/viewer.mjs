@@ -16,10 +16,8 @@
 // and prints one JSON object: { failures: [...], checks: {...}, screenshots: [...] };
 // checks.half_time_poses holds, per animation, the animated node values at half its
 // duration.
-import { chromium } from 'playwright-core';
-import { mkdtempSync, rmSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import { join, resolve } from 'node:path';
+import { launchChromium } from './chromium.mjs';
+import { resolve } from 'node:path';
 import { pathToFileURL } from 'node:url';
 
 const [reportPath, screenshotPrefix] = process.argv.slice(2);
@@ -110,17 +108,7 @@ async function dragJoint(page, screen) {
   if (!(checks.drag_reset_degrees < 1e-6)) failures.push(`"Reset pose" left joint ${checks.drag_joint} turned by ${checks.drag_reset_degrees}°`);
 }
 
-const userDataDir = mkdtempSync(join(tmpdir(), 'atlas-skin-chromium-'));
-const context = await chromium.launchPersistentContext(userDataDir, {
-  executablePath: '/usr/bin/chromium',
-  headless: true,
-  viewport: { width: 1280, height: 800 },
-  args: [
-    '--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-    '--disable-background-networking', '--disable-component-update', '--disable-sync',
-    '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-  ],
-});
+const { context, close } = await launchChromium();
 try {
   context.on('request', (request) => {
     const url = request.url();
@@ -231,7 +219,6 @@ try {
 } catch (error) {
   failures.push(String(error && error.stack ? error.stack : error));
 } finally {
-  await context.close();
-  rmSync(userDataDir, { recursive: true, force: true });
+  await close();
 }
 console.log(JSON.stringify({ failures, checks, screenshots }, null, 1));
