@@ -20,9 +20,28 @@ pub struct JointWeight {
     pub bone_distance: f64,
     /// `bone_distance` over the distance to the nearest bone of any joint (1 for the
     /// nearest bone itself): a weight on a joint whose bones are several times farther than
-    /// the nearest is a gross misassignment.
-    #[serde(default)]
+    /// the nearest is a gross misassignment. Unbounded (`f64::INFINITY`, `null` in JSON,
+    /// which has no infinity) when the vertex lies on another joint's bone.
+    #[serde(default, with = "unbounded")]
     pub bone_distance_ratio: f64,
+}
+
+/// An `f64` that may be `+∞`, written `null` in JSON (serde_json writes every non-finite
+/// number as `null`, and reads `null` back only into an `Option`).
+mod unbounded {
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error> {
+        if x.is_finite() {
+            s.serialize_f64(*x)
+        } else {
+            s.serialize_none()
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::INFINITY))
+    }
 }
 
 /// A vertex with a large deformation error, and the two weight rows that cause it.
@@ -146,5 +165,39 @@ mod tests {
         assert_eq!(worst[1].candidate[0].joint, "b");
         assert!((worst[1].candidate[0].bone_distance_ratio - 2.0).abs() < 1e-12);
         assert!(worst_vertices(&errors, &rows, 0).is_empty());
+    }
+
+    #[test]
+    fn a_vertex_on_another_joints_bone_has_an_unbounded_ratio_that_survives_json() {
+        let errors = [VertexError {
+            max: 0.5,
+            palette: 0,
+        }];
+        let reference = VertexWeights::from_rows([vec![(0, 1.0)]]);
+        let candidate = VertexWeights::from_rows([vec![(1, 0.75), (0, 0.25)]]);
+        let names = ["a".to_string(), "b".to_string()];
+        let rows = Rows {
+            stored: &[0],
+            // On a's bone, 1 from b's.
+            positions: &[Vec3::X * 0.5],
+            reference: &reference,
+            candidate: &candidate,
+            names: &names,
+            segments: &[
+                (0, DVec3::ZERO, DVec3::X),
+                (1, DVec3::Y, DVec3::new(1.0, 1.0, 0.0)),
+            ],
+            diagonal: 1.0,
+        };
+        let worst = worst_vertices(&errors, &rows, 1);
+        assert_eq!(worst[0].candidate[0].bone_distance_ratio, f64::INFINITY);
+        assert_eq!(worst[0].candidate[1].bone_distance_ratio, 1.0);
+        let json = serde_json::to_string(&worst).unwrap();
+        assert!(json.contains(r#""bone_distance_ratio":null"#), "{json}");
+        let back: Vec<WorstVertex> = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, worst);
+        // Rows written before the field existed still read.
+        let old: JointWeight = serde_json::from_str(r#"{"joint":"a","weight":1.0}"#).unwrap();
+        assert_eq!(old.bone_distance_ratio, 0.0);
     }
 }
