@@ -17,8 +17,9 @@ skeleton, all imported with Blender's glTF importer and their weights removed:
 - running again gives the same groups, bit for bit; undo takes everything back;
 - Blender's own "With Automatic Weights" is timed on the same meshes (printed beside the
   add-on's time, with the vertices it leaves in no group; not asserted).
-Then: the redo options against the command line's, the error paths, modifiers, the
-transfer operator (transfer_checks.py), and a
+Then: the redo options against the command line's; Bone Tails on an arm holding a sword
+along its hand bone's tail (the sword follows the hand with tails, the forearm without);
+the error paths, modifiers, the transfer operator (transfer_checks.py), and a
 Workbench render of the posed KayKit character coloured by its weights (the README's).
 
 Usage: python parent_with_atlas_skin.py EXTENSION.zip ATLAS_SKIN DATA_DIR OUT_DIR
@@ -184,20 +185,92 @@ def check_options(path):
               f"differ from the defaults by up to {differs:.2f}")
 
 
-def check_tails(path):
-    """Bone tails (on by default) make leaf bones segments, which a glTF file has not; both
-    ways the weights are valid. Since 37dbda8 a leaf's tail moves only its bone's segment
-    (read by the far-bone guard and the pieces), which changes no weight of the knight."""
-    armature, meshes = import_character(path)
+def check_tails(knight):
+    """Bone Tails (on by default): a leaf bone ends at its tail; off, it runs on past its head
+    by half its parent bone along the parent's direction, as for a glTF file's end joint.
+    An arm (shoulder, elbow, hand: a tube along +X) holds a sword apart from it, pointing
+    down and back from the hand along the hand bone's tail: with tails the hand bone runs
+    inside the sword, which moves with the hand; without, the sword holds no bone and moves
+    with the forearm, nearest to all of it. The arm's weights are the same both ways. Then
+    the knight with tails: valid weights (the same as without, its leaves' tails changing no
+    piece of it)."""
+    weights = {}
+    for use_tails in (True, False):
+        armature, arm, sword = arm_with_sword()
+        assert run_operator(armature, [arm, sword], use_tails=use_tails) == {"FINISHED"}
+        names = deforming_names(armature)
+        check_groups(f"arm with a sword, use_tails={use_tails}", [arm, sword], names)
+        weights[use_tails] = {o.name: bone_weights(o, names) for o in (arm, sword)}
+    hand, forearm = names.index("hand"), names.index("forearm")
+    with_tails, heads_only = weights[True]["sword"], weights[False]["sword"]
+    assert with_tails[:, hand].min() >= 0.99, f"with tails, the sword not the hand's: {with_tails}"
+    assert heads_only[:, forearm].min() >= 0.99, f"without, not the forearm's: {heads_only}"
+    arm_differs = np.abs(weights[True]["arm"] - weights[False]["arm"]).max()
+    assert arm_differs <= TOLERANCE, f"the tail changed the arm's weights by {arm_differs}"
+    armature, meshes = import_character(knight)
     strip_weights(meshes)
     assert run_operator(armature, meshes) == {"FINISHED"}
-    check_groups("with bone tails", meshes, deforming_names(armature))
-    armature, meshes = import_character(path)
-    strip_weights(meshes)
-    assert run_operator(armature, meshes, use_tails=False) == {"FINISHED"}
-    check_groups("without bone tails", meshes, deforming_names(armature))
-    differs = np.abs(weights_with(path) - weights_with(path, use_tails=False)).max()
-    print(f"bone tails: valid weights, differ from the heads alone by up to {differs:.2f}")
+    names = deforming_names(armature)
+    check_groups("knight with bone tails", meshes, names)
+    knight_tails = np.concatenate([bone_weights(o, names) for o in meshes])
+    knight_differs = np.abs(knight_tails - weights_with(knight, use_tails=False)).max()
+    print(f"bone tails: the sword takes the hand with tails (weight >= "
+          f"{with_tails[:, hand].min():.2f}), the forearm without (>= "
+          f"{heads_only[:, forearm].min():.2f}), the arm unchanged; the knight valid with tails, "
+          f"{knight_differs:.2f} from its weights without")
+
+
+def arm_with_sword():
+    """Empty scene; (armature, arm, sword), Blender's axes (+Z up). Bones upperarm (0, 0, 0)
+    → forearm (1, 0, 0) → hand (2, 0, 0), the hand's tail at (1.5, 0, -1.2), down and back.
+    The arm: a closed tube of radius 0.15 along X from -0.2 to 2.5, rings every 0.1 of 16
+    vertices, each end a fan around a centre vertex. The sword: a box 0.1 thick (8
+    vertices) along the hand bone from 30% of its length (about 0.2 below the arm) to its tail."""
+    empty_scene()
+    rings, sides, radius, x0, x1 = 28, 16, 0.15, -0.2, 2.5
+    angles = 2 * np.pi * np.arange(sides) / sides
+    vertices = [(x, radius * np.cos(a), radius * np.sin(a))
+                for x in np.linspace(x0, x1, rings) for a in angles]
+    faces = [(k * sides + s, k * sides + (s + 1) % sides,
+              (k + 1) * sides + (s + 1) % sides, (k + 1) * sides + s)
+             for k in range(rings - 1) for s in range(sides)]
+    first, last, end = len(vertices), len(vertices) + 1, (rings - 1) * sides
+    vertices += [(x0, 0.0, 0.0), (x1, 0.0, 0.0)]
+    for s in range(sides):
+        faces += [(first, (s + 1) % sides, s), (last, end + s, end + (s + 1) % sides)]
+    arm = mesh_object("arm", vertices, faces)
+    hand, tail = Vector((2.0, 0.0, 0.0)), Vector((1.5, 0.0, -1.2))
+    start = hand + 0.3 * (tail - hand)
+    depth = Vector((0.0, 0.05, 0.0))
+    across = depth.cross(tail - hand).normalized() * 0.05  # (along, across, depth) right-handed
+    corners = [start + i * (tail - start) + j * across + k * depth
+               for i in (0, 1) for j in (-1, 1) for k in (-1, 1)]
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    sword = mesh_object("sword", corners, quads)
+    armature = bpy.data.objects.new("rig", bpy.data.armatures.new("rig"))
+    bpy.context.collection.objects.link(armature)
+    bpy.context.view_layer.objects.active = armature
+    bpy.ops.object.mode_set(mode="EDIT")
+    parent = None
+    for name, head, bone_tail in (
+        ("upperarm", (0.0, 0.0, 0.0), (1.0, 0.0, 0.0)),
+        ("forearm", (1.0, 0.0, 0.0), (2.0, 0.0, 0.0)),
+        ("hand", hand, tail),
+    ):
+        bone = armature.data.edit_bones.new(name)
+        bone.head, bone.tail, bone.parent = head, bone_tail, parent
+        parent = bone
+    bpy.ops.object.mode_set(mode="OBJECT")
+    return armature, arm, sword
+
+
+def mesh_object(name, vertices, faces):
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata([tuple(v) for v in vertices], [], faces)
+    mesh.update()
+    obj = bpy.data.objects.new(name, mesh)
+    bpy.context.collection.objects.link(obj)
+    return obj
 
 
 def expect_error(armature, meshes, fragment, **options):
