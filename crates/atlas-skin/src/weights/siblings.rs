@@ -7,18 +7,18 @@
 //! soft boundaries of one region reach the same skin (the base of a neck between the
 //! shoulders). Posed, such a vertex follows the average of two transforms that turn about
 //! different pivots in unrelated directions and lands where neither limb is; artists give
-//! that skin to the joint the two limbs hang from. So part of the pair's shared weight goes
-//! to their lowest common ancestor a:
+//! that skin to the joint the two limbs hang from. So the part of the vertex the pair
+//! shares goes to their lowest common ancestor a:
 //!
-//!   t_jk = s · f_jk · (min(w_j, w_k) − m₀)⁺ / (1 − 2 m₀),
+//!   t_jk = f_jk · min(w_j, w_k),
 //!   f_jk = 1 − β(clamp((d_a / min(d_j, d_k) − ρ₀) / (ρ₁ − ρ₀), 0, 1)),
 //!
 //! with w the vertex's weights of steps 1–3, d_x the distance from the vertex to the nearest
 //! bone segment of joint x ([`JointBones::distance`]), β the transition function of §4
-//! ([`super::blend::beta`]), s = [`SHARE`], m₀ = [`TAIL`], ρ₀ = [`NEAR_RATIO`], ρ₁ =
-//! [`FAR_RATIO`]. On a midline (w_j = w_k = ½) each gives s/2 of its weight. A common
-//! weight below m₀ is the tail of an ordinary transition that reaches a sibling's bone, and
-//! stays. The ancestor takes the weight only where its own bones are about as near as the
+//! ([`super::blend::beta`]), ρ₀ = [`NEAR_RATIO`], ρ₁ = [`FAR_RATIO`]. On a midline
+//! (w_j = w_k = ½) the vertex goes wholly to the ancestor; where one of the pair holds
+//! little, only that little moves, so the weights change continuously as the pair's do. The
+//! ancestor takes the weight only where its own bones are about as near as the
 //! pair's (a pelvis joint high above a crotch that the thighs' bones pass beside is not, and
 //! the crotch stays with the thighs). Each joint j gives t_jk to the ancestor of every pair it is
 //! in, scaled by c_j = min(1, w_j / Σ_k t_jk) so that no weight goes negative:
@@ -35,13 +35,6 @@ use crate::skeleton::ancestry::Ancestry;
 use crate::skeleton::bones::JointBones;
 use atlas_skin_runtime::Skeleton;
 use glam::DVec3;
-
-/// s: the share of a sibling pair's common weight min(w_j, w_k) that each of the two gives
-/// to their common ancestor (chosen on the benchmark, docs/measurements.md).
-pub const SHARE: f64 = 0.5;
-
-/// m₀: a sibling pair's common weight up to this is left alone (docs/measurements.md).
-pub const TAIL: f64 = 0.05;
 
 /// ρ₀: the ancestor takes the full share while its bones are at most this many times
 /// farther from the vertex than the nearer of the pair's.
@@ -136,8 +129,7 @@ impl<'a> Family<'a> {
                 let ratio = distance(a) / near;
                 let reach =
                     1.0 - beta(((ratio - NEAR_RATIO) / (FAR_RATIO - NEAR_RATIO)).clamp(0.0, 1.0));
-                let common = (wj.min(wk) - TAIL).max(0.0) / (1.0 - 2.0 * TAIL);
-                let amount = SHARE * reach * common;
+                let amount = reach * wj.min(wk);
                 if amount > 0.0 {
                     transfers.push((x, a, amount));
                     transfers.push((y, a, amount));
@@ -292,18 +284,14 @@ mod tests {
     }
 
     #[test]
-    fn a_midline_between_two_thighs_goes_half_to_the_pelvis() {
+    fn a_midline_between_two_thighs_goes_to_the_pelvis() {
         // Bones of the hips run from (±0.1, 0, 0) down: a crotch point at (0, -0.05, 0.05)
         // is 0.112 from each and 0.071 from the pelvis's bones (to the hips, to the spine).
         let skeleton = legs(0.1);
         let p = DVec3::new(0.0, -0.05, 0.05);
         let row = merged(&skeleton, p, &[(2, 0.5), (4, 0.5)]);
-        // Each thigh gives s · (½ − m₀) / (1 − 2 m₀) = s / 2 of its ½.
-        let given = SHARE * 0.5;
-        assert!((weight(&row, 0) - 2.0 * given).abs() < 1e-12, "{row:?}");
-        assert!((weight(&row, 2) - (0.5 - given)).abs() < 1e-12, "{row:?}");
-        assert!((weight(&row, 4) - (0.5 - given)).abs() < 1e-12, "{row:?}");
-        assert!((row.iter().map(|e| e.1).sum::<f64>() - 1.0).abs() < 1e-12);
+        // The pelvis's bones are the nearer (f = 1): each thigh gives min(½, ½), all of it.
+        assert_eq!(row, vec![(0, 1.0)]);
     }
 
     #[test]
@@ -314,7 +302,7 @@ mod tests {
         let skeleton = legs(0.5);
         let near = DVec3::new(0.0, -0.6, 0.0);
         let row = merged(&skeleton, near, &[(2, 0.5), (4, 0.5)]);
-        assert!(weight(&row, 0) > 0.0 && weight(&row, 0) < SHARE, "{row:?}");
+        assert!(weight(&row, 0) > 0.0 && weight(&row, 0) < 1.0, "{row:?}");
         // ... and at y = −1 it is 1 from them against the thighs' 0.5 (ratio 2 > ρ₁).
         let far = DVec3::new(0.0, -1.0, 0.0);
         let row = merged(&skeleton, far, &[(2, 0.5), (4, 0.5)]);
@@ -322,15 +310,19 @@ mod tests {
     }
 
     #[test]
-    fn parents_and_children_and_tails_are_left_alone() {
+    fn parents_and_children_are_left_alone_and_a_small_share_moves_only_itself() {
         let skeleton = legs(0.1);
         let p = DVec3::new(0.05, -0.05, 0.05);
         // A thigh and its own knee: not siblings.
         let row = [(2, 0.5), (3, 0.5)];
         assert_eq!(merged(&skeleton, p, &row), row.to_vec());
-        // A common weight of m₀ or less is a transition's tail.
-        let row = [(2, 1.0 - TAIL), (4, TAIL)];
-        assert_eq!(merged(&skeleton, p, &row), row.to_vec());
+        // On the crotch's midline (f = 1) a thigh holding 0.05 gives it, and the other thigh
+        // as much: the pelvis takes 0.1.
+        let crotch = DVec3::new(0.0, -0.05, 0.05);
+        let row = merged(&skeleton, crotch, &[(2, 0.95), (4, 0.05)]);
+        assert!((weight(&row, 0) - 0.1).abs() < 1e-12, "{row:?}");
+        assert!((weight(&row, 2) - 0.9).abs() < 1e-12, "{row:?}");
+        assert_eq!(weight(&row, 4), 0.0, "{row:?}");
     }
 
     #[test]
