@@ -31,6 +31,16 @@ fn batch_ok<A: Into<OsString> + Clone>(args: &[A]) -> String {
     String::from_utf8_lossy(&output.stdout).into_owned()
 }
 
+/// `atlas-skin batch INPUT -o OUT --resume`, failing unless it exits 0; returns its stdout.
+fn resume_ok(input: &Path, out: &Path) -> String {
+    batch_ok(&[
+        input.as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+        "--resume".as_ref(),
+    ])
+}
+
 /// The records of a batch log.
 fn log_records(path: &Path) -> Vec<Value> {
     std::fs::read_to_string(path)
@@ -135,12 +145,7 @@ fn bench_gives_65_valid_glbs_then_resume_does_nothing() {
     }
 
     let before: Vec<SystemTime> = glbs.iter().map(|g| modified(g)).collect();
-    let stdout = batch_ok(&[
-        bench.as_os_str(),
-        "-o".as_ref(),
-        out.as_os_str(),
-        "--resume".as_ref(),
-    ]);
+    let stdout = resume_ok(&bench, &out);
     assert!(
         stdout.contains("nothing to do: the outputs of all 65 files are up to date"),
         "{stdout}"
@@ -255,12 +260,7 @@ fn a_killed_batch_leaves_complete_files_and_resume_finishes_it() {
     let kept = out.join(".Knight.glb.notes.tmp");
     std::fs::write(&leftover, b"half a glb").unwrap();
     std::fs::write(&kept, b"mine").unwrap();
-    let stdout = batch_ok(&[
-        bench.as_os_str(),
-        "-o".as_ref(),
-        out.as_os_str(),
-        "--resume".as_ref(),
-    ]);
+    let stdout = resume_ok(&bench, &out);
     assert!(
         !leftover.exists(),
         "--resume removes the killed run's temporary files"
@@ -284,12 +284,7 @@ fn resume_redoes_a_file_newer_than_its_output() {
     std::thread::sleep(Duration::from_millis(20));
     let bytes = std::fs::read(&input).unwrap();
     std::fs::write(&input, bytes).unwrap();
-    let stdout = batch_ok(&[
-        input.as_os_str(),
-        "-o".as_ref(),
-        out.as_os_str(),
-        "--resume".as_ref(),
-    ]);
+    let stdout = resume_ok(&input, &out);
     assert!(
         stdout.contains("1 file: 1 skinned, 0 failed, 0 up to date"),
         "{stdout}"

@@ -84,6 +84,17 @@ fn plus(
     files
 }
 
+/// The case `name` that runs [`SKIN`] on `files` and may write `out.glb`.
+fn skin_case(name: &'static str, files: Vec<(&'static str, Source)>, expect: Expect) -> Case {
+    Case {
+        name,
+        files,
+        args: SKIN,
+        outputs: vec!["out.glb"],
+        expect,
+    }
+}
+
 fn riggedsimple() -> Vec<(&'static str, Source)> {
     vec![(
         "in.glb",
@@ -160,22 +171,16 @@ const CARELESS: &[(&str, &str, &str)] = &[
 ];
 
 fn cases() -> Vec<Case> {
-    let bad_buffer = |name, uri: &'static str, problem| Case {
-        name,
-        files: simpleskin_case(|j| j["buffers"][0]["uri"] = json!(uri)),
-        args: SKIN,
-        outputs: vec!["out.glb"],
-        expect: Expect::Error(problem),
+    let bad_buffer = |name, uri: &'static str, problem| {
+        let files = simpleskin_case(|j| j["buffers"][0]["uri"] = json!(uri));
+        skin_case(name, files, Expect::Error(problem))
     };
-    let bad_image = |name, uri: &'static str| Case {
-        name,
-        files: simpleskin_case(|j| {
+    let bad_image = |name, uri: &'static str| {
+        let files = simpleskin_case(|j| {
             j["images"] = json!([{ "uri": uri }]);
             j["textures"] = json!([{ "source": 0 }]);
-        }),
-        args: SKIN,
-        outputs: vec!["out.glb"],
-        expect: Expect::Success,
+        });
+        skin_case(name, files, Expect::Success)
     };
     let careless = CARELESS.iter().map(|&(name, args, problem)| Case {
         name,
@@ -206,31 +211,27 @@ fn cases() -> Vec<Case> {
             "file:///dev/urandom",
             "not a data: URI",
         ),
-        Case {
-            name: "buffer-link-outside",
-            files: plus(
+        skin_case(
+            "buffer-link-outside",
+            plus(
                 simpleskin_case(|j| j["buffers"][0]["uri"] = json!("link.bin")),
                 "link.bin",
                 Source::Link("{secret}"),
             ),
-            args: SKIN,
-            outputs: vec!["out.glb"],
-            expect: Expect::Error("outside the document's folder"),
-        },
-        Case {
-            name: "buffer-fifo",
-            files: plus(
+            Expect::Error("outside the document's folder"),
+        ),
+        skin_case(
+            "buffer-fifo",
+            plus(
                 simpleskin_case(|j| j["buffers"][0]["uri"] = json!("pipe.bin")),
                 "pipe.bin",
                 Source::Fifo,
             ),
-            args: SKIN,
-            outputs: vec!["out.glb"],
-            expect: Expect::Error("not a regular file"),
-        },
-        Case {
-            name: "buffer-read-600-times",
-            files: plus(
+            Expect::Error("not a regular file"),
+        ),
+        skin_case(
+            "buffer-read-600-times",
+            plus(
                 simpleskin_case(|j| {
                     let big = json!({"uri": "big.bin", "byteLength": 16 << 20});
                     let buffers = j["buffers"].as_array_mut().unwrap();
@@ -239,36 +240,30 @@ fn cases() -> Vec<Case> {
                 "big.bin",
                 Source::Bytes(vec![7; 16 << 20]),
             ),
-            args: SKIN,
-            outputs: vec!["out.glb"],
-            expect: Expect::Error("a document may load"),
-        },
-        Case {
-            name: "accessors-beyond-the-budget",
-            files: simpleskin_case(|j| {
+            Expect::Error("a document may load"),
+        ),
+        skin_case(
+            "accessors-beyond-the-budget",
+            simpleskin_case(|j| {
                 let accessors = j["accessors"].as_array_mut().unwrap();
                 let zeros = accessors.len();
                 accessors.push(json!({"componentType": 5126, "count": 1 << 24, "type": "MAT4"}));
                 j["skins"][0]["inverseBindMatrices"] = json!(zeros);
             }),
-            args: SKIN,
-            outputs: vec!["out.glb"],
-            expect: Expect::Error("budget"),
-        },
-        Case {
-            name: "position-without-bounds",
-            files: simpleskin_case(|j| {
+            Expect::Error("budget"),
+        ),
+        skin_case(
+            "position-without-bounds",
+            simpleskin_case(|j| {
                 let position = j["accessors"][1].as_object_mut().unwrap();
                 position.remove("min");
                 position.remove("max");
             }),
-            args: SKIN,
-            outputs: vec!["out.glb"],
-            expect: Expect::Success,
-        },
-        Case {
-            name: "projective-inverse-bind-matrix",
-            files: simpleskin_case(|j| {
+            Expect::Success,
+        ),
+        skin_case(
+            "projective-inverse-bind-matrix",
+            simpleskin_case(|j| {
                 use base64::Engine;
                 let engine = base64::engine::general_purpose::STANDARD;
                 // Buffer 2 holds the inverse bind matrices: joint 0's last row gets x = 0.5.
@@ -278,17 +273,13 @@ fn cases() -> Vec<Case> {
                 bytes[12..16].copy_from_slice(&0.5f32.to_le_bytes());
                 j["buffers"][2]["uri"] = json!(format!("{header},{}", engine.encode(bytes)));
             }),
-            args: SKIN,
-            outputs: vec!["out.glb"],
-            expect: Expect::Success,
-        },
-        Case {
-            name: "joint-with-the-skinned-mesh",
-            files: simpleskin_case(|j| j["nodes"][1]["mesh"] = json!(0)),
-            args: SKIN,
-            outputs: vec!["out.glb"],
-            expect: Expect::Error("is a joint of the skin and also instantiates"),
-        },
+            Expect::Success,
+        ),
+        skin_case(
+            "joint-with-the-skinned-mesh",
+            simpleskin_case(|j| j["nodes"][1]["mesh"] = json!(0)),
+            Expect::Error("is a joint of the skin and also instantiates"),
+        ),
         Case {
             name: "inspect-200k-node-chain",
             files: simpleskin_case(|j| {

@@ -6,6 +6,9 @@
 //! mesh's vertex order and grouped by influence count (`VertexOrder`); and what quantising
 //! the weights costs in accuracy (`QUANTISED_ERROR`).
 
+#[path = "../../atlas-skin-runtime/tests/skinning_support/mod.rs"]
+mod skinning_support;
+
 use atlas_skin_io::LoadOptions;
 use atlas_skin_runtime::pose::palette_from_world;
 use atlas_skin_runtime::random_pose::random_rotations;
@@ -18,6 +21,7 @@ use atlas_skin_runtime::{
     VertexOrder, WeightFormat,
 };
 use glam::{Mat4, Vec3};
+use skinning_support::{diagonal, max_distance};
 use std::path::Path;
 
 const MODELS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/models");
@@ -58,20 +62,6 @@ const CORPUS: [Model; 7] = [
         Some("default_weights.mhw"),
     ),
 ];
-
-fn diagonal(points: &[Vec3]) -> f32 {
-    let (lo, hi) = points.iter().fold((Vec3::MAX, Vec3::MIN), |(lo, hi), p| {
-        (lo.min(*p), hi.max(*p))
-    });
-    (hi - lo).length()
-}
-
-fn max_distance(a: &[Vec3], b: &[Vec3]) -> f32 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| x.distance(*y))
-        .fold(0.0, f32::max)
-}
 
 /// Largest distance, in units of the bounding-box diagonal, between the reference
 /// deformation with quantised weights and with the float weights they come from, over the

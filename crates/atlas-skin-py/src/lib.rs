@@ -329,6 +329,23 @@ fn character_dict<'py>(py: Python<'py>, character: &Character) -> PyResult<Bound
     Ok(dict)
 }
 
+/// The character file `path` with the companion files and OBJ group of the keyword arguments.
+fn file_input(
+    path: PathBuf,
+    skeleton: Option<PathBuf>,
+    group: Option<String>,
+    weights: Option<PathBuf>,
+) -> Input {
+    Input {
+        path: Some(path),
+        load: LoadOptions {
+            skeleton,
+            group,
+            weights,
+        },
+    }
+}
+
 #[pyfunction]
 #[pyo3(signature = (path, *, skeleton=None, group=None, weights=None))]
 fn load<'py>(
@@ -338,14 +355,7 @@ fn load<'py>(
     group: Option<String>,
     weights: Option<PathBuf>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let input = Input {
-        path: Some(path),
-        load: LoadOptions {
-            skeleton,
-            group,
-            weights,
-        },
-    };
+    let input = file_input(path, skeleton, group, weights);
     let character =
         py.detach(|| no_panic(|| input.load().map_err(|e| to_py_err(&JobError::Io(e)))))?;
     character_dict(py, &character)
@@ -412,14 +422,7 @@ fn skin_file<'py>(
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let job = SkinJob {
-        input: Input {
-            path: Some(input),
-            load: LoadOptions {
-                skeleton,
-                group,
-                weights,
-            },
-        },
+        input: file_input(input, skeleton, group, weights),
         settings: method_settings(options)?,
         outputs: Outputs {
             glb: output,
@@ -662,14 +665,7 @@ fn transfer_file<'py>(
     smooth_alpha: Option<f64>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let job = TransferJob {
-        source: Input {
-            path: Some(source),
-            load: LoadOptions {
-                skeleton,
-                group: None,
-                weights,
-            },
-        },
+        source: file_input(source, skeleton, None, weights),
         targets,
         meshes: meshes.unwrap_or_default(),
         params: transfer_params(

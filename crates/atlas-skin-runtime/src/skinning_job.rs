@@ -187,14 +187,34 @@ trait Blend: Copy + Send + Sync {
     /// Blends the transforms of `joints` with weights `explicit` (#joints − 1 of them; the
     /// last is `1 − Σ explicit`).
     fn blend(palette: &[Self], joints: &[u16], explicit: &[f32]) -> Mat4;
-    /// The vector loop of `set` (a supported family), or of the next narrower family
-    /// when `set` has none for this case; `None` for the portable loop.
-    fn simd_kernel(
-        set: InstructionSet,
-        k: usize,
-        normals: bool,
-        tangents: bool,
-    ) -> Option<Kernel<Self>>;
+    /// The AVX2 loop for `k` influences and the streams present, if the CPU has AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    fn avx2_kernel(k: usize, normals: bool, tangents: bool) -> Option<Kernel<Self>>;
+    /// The AVX-512 loop, as [`Blend::avx2_kernel`]; `None` where the blend has none.
+    #[cfg(target_arch = "x86_64")]
+    fn avx512_kernel(_k: usize, _normals: bool, _tangents: bool) -> Option<Kernel<Self>> {
+        None
+    }
+}
+
+/// The vector loop of `set` (a supported family), or of the next narrower family when
+/// `set` has none for this case; `None` for the portable loop.
+fn simd_kernel<B: Blend>(
+    set: InstructionSet,
+    k: usize,
+    normals: bool,
+    tangents: bool,
+) -> Option<Kernel<B>> {
+    #[cfg(target_arch = "x86_64")]
+    return match set {
+        InstructionSet::Portable => None,
+        InstructionSet::Avx2 => B::avx2_kernel(k, normals, tangents),
+        InstructionSet::Avx512 => {
+            B::avx512_kernel(k, normals, tangents).or_else(|| B::avx2_kernel(k, normals, tangents))
+        }
+    };
+    #[cfg(not(target_arch = "x86_64"))]
+    return None;
 }
 
 impl Blend for Mat4 {
@@ -213,23 +233,14 @@ impl Blend for Mat4 {
         blended + palette[usize::from(joints[last])] * (1.0 - sum)
     }
 
-    fn simd_kernel(
-        set: InstructionSet,
-        k: usize,
-        normals: bool,
-        tangents: bool,
-    ) -> Option<Kernel<Self>> {
-        #[cfg(target_arch = "x86_64")]
-        return match set {
-            InstructionSet::Portable => None,
-            InstructionSet::Avx2 => crate::skinning_avx2::linear_blend_kernel(k, normals, tangents),
-            InstructionSet::Avx512 => {
-                crate::skinning_avx512::linear_blend_kernel(k, normals, tangents)
-                    .or_else(|| crate::skinning_avx2::linear_blend_kernel(k, normals, tangents))
-            }
-        };
-        #[cfg(not(target_arch = "x86_64"))]
-        return None;
+    #[cfg(target_arch = "x86_64")]
+    fn avx2_kernel(k: usize, normals: bool, tangents: bool) -> Option<Kernel<Self>> {
+        crate::skinning_avx2::linear_blend_kernel(k, normals, tangents)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    fn avx512_kernel(k: usize, normals: bool, tangents: bool) -> Option<Kernel<Self>> {
+        crate::skinning_avx512::linear_blend_kernel(k, normals, tangents)
     }
 }
 
@@ -262,21 +273,9 @@ impl Blend for DualQuat {
         DualQuat { real, dual }.normalized_matrix()
     }
 
-    fn simd_kernel(
-        set: InstructionSet,
-        k: usize,
-        normals: bool,
-        tangents: bool,
-    ) -> Option<Kernel<Self>> {
-        #[cfg(target_arch = "x86_64")]
-        return match set {
-            InstructionSet::Portable => None,
-            InstructionSet::Avx2 | InstructionSet::Avx512 => {
-                crate::skinning_avx2::dual_quaternion_kernel(k, normals, tangents)
-            }
-        };
-        #[cfg(not(target_arch = "x86_64"))]
-        return None;
+    #[cfg(target_arch = "x86_64")]
+    fn avx2_kernel(k: usize, normals: bool, tangents: bool) -> Option<Kernel<Self>> {
+        crate::skinning_avx2::dual_quaternion_kernel(k, normals, tangents)
     }
 }
 
@@ -480,7 +479,7 @@ fn dispatch<B: Blend>(
 ) {
     let normals = !span.out_normals.is_empty();
     let tangents = !span.out_tangents.is_empty();
-    let kernel = B::simd_kernel(set, k, normals, tangents)
+    let kernel = simd_kernel::<B>(set, k, normals, tangents)
         .unwrap_or_else(|| portable_kernel::<B>(k, normals, tangents));
     match threading {
         Threading::Sequential => run_dequantised(palette, k, span, kernel),

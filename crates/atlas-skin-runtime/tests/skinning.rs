@@ -1,6 +1,8 @@
 //! The fast skinning job against the scalar reference, and the properties the issue
 //! names: identity pose = rest mesh, one rigid joint = that transform, the candy wrapper.
 
+mod skinning_support;
+
 use atlas_skin_runtime::reference::{
     dual_quaternion_positions, dual_quaternion_vectors, linear_blend_positions,
     linear_blend_vectors,
@@ -11,6 +13,7 @@ use atlas_skin_runtime::{
 };
 use glam::{Mat4, Quat, Vec3, Vec4};
 use proptest::prelude::*;
+use skinning_support::{diagonal, max_distance};
 
 /// Output streams of one run (tangents stay zero when the run has none: the loops
 /// specialise on the streams present, so tests run both ways).
@@ -83,20 +86,6 @@ fn run_job_aligned(
     }
     .run_with(set)?;
     Ok(posed)
-}
-
-fn diagonal(points: &[Vec3]) -> f32 {
-    let (lo, hi) = points.iter().fold((Vec3::MAX, Vec3::MIN), |(lo, hi), p| {
-        (lo.min(*p), hi.max(*p))
-    });
-    (hi - lo).length()
-}
-
-fn max_distance(a: &[Vec3], b: &[Vec3]) -> f32 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| x.distance(*y))
-        .fold(0.0, f32::max)
 }
 
 /// A random rigid transform: rotation from four floats, translation from three.

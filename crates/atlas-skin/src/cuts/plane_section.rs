@@ -990,6 +990,13 @@ mod tests {
         (0..mesh.triangle_count() as u32).collect()
     }
 
+    /// The domain of every face of `mesh`, vertices snapped within 0.01 of their longest edge.
+    fn whole_mesh_domain(mesh: &SurfaceMesh, topology: &Topology) -> SectionDomain {
+        let snap = vertex_snap_distances(mesh, topology, 0.01);
+        let faces = all_faces(mesh);
+        SectionDomain::new(mesh, topology, &snap, faces, &mut DomainScratch::default())
+    }
+
     /// Deterministic numbers in [0, 1) (a linear congruential generator).
     fn numbers(mut seed: u64) -> impl FnMut() -> f64 {
         move || {
@@ -1105,16 +1112,7 @@ mod tests {
     fn kept_differences_give_the_distances_of_the_formula() {
         let mesh = icosphere(1.0, 3);
         let topology = Topology::new(&mesh);
-        let snap = vertex_snap_distances(&mesh, &topology, 0.01);
-        let new_domain = || {
-            SectionDomain::new(
-                &mesh,
-                &topology,
-                &snap,
-                all_faces(&mesh),
-                &mut DomainScratch::default(),
-            )
-        };
+        let new_domain = || whole_mesh_domain(&mesh, &topology);
         let mut domain = new_domain();
         let mut random = numbers(5);
         let points = [
@@ -1140,14 +1138,7 @@ mod tests {
     fn equator_of_a_sphere_is_one_closed_circle() {
         let mesh = icosphere(1.0, 4);
         let topology = Topology::new(&mesh);
-        let snap = vertex_snap_distances(&mesh, &topology, 0.01);
-        let mut domain = SectionDomain::new(
-            &mesh,
-            &topology,
-            &snap,
-            all_faces(&mesh),
-            &mut DomainScratch::default(),
-        );
+        let mut domain = whole_mesh_domain(&mesh, &topology);
         let plane = Plane {
             point: DVec3::new(0.0, 0.0, 0.3),
             normal: DVec3::Z,
@@ -1174,14 +1165,7 @@ mod tests {
         // The uv sphere's equator ring lies exactly on z = 0.
         let mesh = uv_sphere(1.0, 8, 16);
         let topology = Topology::new(&mesh);
-        let snap = vertex_snap_distances(&mesh, &topology, 0.01);
-        let mut domain = SectionDomain::new(
-            &mesh,
-            &topology,
-            &snap,
-            all_faces(&mesh),
-            &mut DomainScratch::default(),
-        );
+        let mut domain = whole_mesh_domain(&mesh, &topology);
         let plane = Plane {
             point: DVec3::ZERO,
             normal: DVec3::Z,
