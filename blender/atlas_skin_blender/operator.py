@@ -58,6 +58,21 @@ def max_influences_property():
     )
 
 
+def reported(operator, compute, errors):
+    """Runs an operator's work, `compute()` → (summary line, warnings), and shows its
+    outcome: an error of the types `errors` reported and the operator cancelled, else each
+    warning and then the summary."""
+    try:
+        summary, warnings = compute()
+    except errors as error:
+        operator.report({"ERROR"}, str(error))
+        return {"CANCELLED"}
+    for warning in warnings:
+        operator.report({"WARNING"}, warning)
+    operator.report({"INFO"}, summary)
+    return {"FINISHED"}
+
+
 def selection(context):
     """(armature, meshes) of the selection, or a sentence saying what is missing."""
     selected = context.selected_objects
@@ -150,18 +165,15 @@ class OBJECT_OT_parent_atlas_skin(bpy.types.Operator):
         manager.progress_begin(0, 2 * len(meshes) + 1)
         steps = iter(range(1, 2 * len(meshes) + 2))
         try:
-            summary, warnings = self.parent_with_weights(
-                context, armature, meshes, lambda: manager.progress_update(next(steps))
+            return reported(
+                self,
+                lambda: self.parent_with_weights(
+                    context, armature, meshes, lambda: manager.progress_update(next(steps))
+                ),
+                (MissingPackage, RigError, BodyError, OptionError, Rejected, ValueError),
             )
-        except (MissingPackage, RigError, BodyError, OptionError, Rejected, ValueError) as error:
-            self.report({"ERROR"}, str(error))
-            return {"CANCELLED"}
         finally:
             manager.progress_end()
-        for warning in warnings:
-            self.report({"WARNING"}, warning)
-        self.report({"INFO"}, summary)
-        return {"FINISHED"}
 
     def parent_with_weights(self, context, armature, meshes, progress):
         """Computes and writes the weights; returns the summary line and the warnings.

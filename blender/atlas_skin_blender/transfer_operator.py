@@ -10,7 +10,7 @@ from bpy.props import BoolProperty, FloatProperty, IntProperty
 
 from .binding import bind_to_armature, write_groups
 from .body import BodyError, read_body, rest_state
-from .operator import max_influences_property, polled
+from .operator import max_influences_property, polled, reported
 from .package import MissingPackage, atlas_skin
 from .rig import RigError, deforming_rig
 
@@ -94,15 +94,11 @@ class OBJECT_OT_transfer_atlas_skin(bpy.types.Operator):
 
     def execute(self, context):
         source, armature, targets = skinned_source(context)
-        try:
-            summary, warnings = self.transfer(context, source, armature, targets)
-        except (MissingPackage, RigError, BodyError, ValueError) as error:
-            self.report({"ERROR"}, str(error))
-            return {"CANCELLED"}
-        for warning in warnings:
-            self.report({"WARNING"}, warning)
-        self.report({"INFO"}, summary)
-        return {"FINISHED"}
+        return reported(
+            self,
+            lambda: self.transfer(context, source, armature, targets),
+            (MissingPackage, RigError, BodyError, ValueError),
+        )
 
     def transfer(self, context, source, armature, targets):
         """Computes and writes the weights; returns the summary line and the warnings.
