@@ -4,12 +4,22 @@
 //! With L the cotangent Laplacian and M the Voronoi mass matrix of the target surface
 //! ([`super::cotangent`]), the weights W (one column per joint) minimise
 //!
-//!   E(W) = tr(Wᵀ Q W),  Q = −L + L M⁻¹ L,
+//!   E(W) = tr(Wᵀ Q W),  Q = −L + D² L M⁻¹ L,
 //!
 //! subject to W_i = the matched weights at every matched vertex i: the Dirichlet energy
 //! (−L, the paper's smoothness term) plus the squared Laplacian (L M⁻¹ L, the "Laplacian
-//! energy", which makes the weights' gradient continuous across the matched border). Split
-//! into unknown (u) and matched (k) vertices, the minimiser solves
+//! energy", which makes the weights' gradient continuous across the matched border).
+//!
+//! D is a length, [`System::length`]: the transfer passes the source's bounding-box
+//! diagonal. The paper's Q = −L + L M⁻¹ L (D = 1 in the file's units) is not the same
+//! energy in centimetres as in metres: the Dirichlet energy ∫|∇w|² dA does not change when
+//! the surface is scaled by s, the Laplacian energy ∫(Δw)² dA is divided by s², so the
+//! same garment in centimetres was inpainted almost harmonically and in metres almost
+//! biharmonically. With D² the two terms are weighed as the paper's on a character of
+//! unit diagonal (the scale of its examples, and of the benchmark's characters, whose
+//! diagonals are 1 to 1.7), whatever the units.
+//!
+//! Split into unknown (u) and matched (k) vertices, the minimiser solves
 //!
 //!   Q_uu W_u = −Q_uk W_k,
 //!
@@ -23,8 +33,8 @@
 //! them, see [`super::transfer_weights`]).
 //!
 //! The rows of Q of unknown vertices are assembled directly: Q_ij = −L_ij +
-//! Σ_m L_im L_mj / M_mm over the neighbours m of i (and i itself), so only the two-ring of
-//! each unknown vertex is visited. `dense_reference` (tests) solves the same system
+//! D² Σ_m L_im L_mj / M_mm over the neighbours m of i (and i itself), so only the two-ring
+//! of each unknown vertex is visited. `dense_reference` (tests) solves the same system
 //! densely.
 
 use super::cotangent::Operators;
@@ -55,6 +65,9 @@ pub struct System<'a> {
     pub slot: &'a [u32],
     /// Columns of the solution (the joints of the piece).
     pub columns: usize,
+    /// D of Q = −L + D² L M⁻¹ L (> 0): the length at which the two energies are weighed
+    /// as the paper weighs them at unit length.
+    pub length: f64,
 }
 
 /// [`System::slot`] of a vertex that is not unknown.
@@ -65,6 +78,7 @@ impl System<'_> {
     /// appended to `out`; `scratch` is left as found.
     fn q_row(&self, i: usize, scratch: &mut RowScratch, out: &mut Vec<(u32, f64)>) {
         let ops = self.operators;
+        let length2 = self.length * self.length;
         scratch.add(i as u32, -ops.diagonal[i]);
         for &(j, l) in ops.off_diagonal.row(i) {
             scratch.add(j, -l);
@@ -77,7 +91,7 @@ impl System<'_> {
                 // An empty Laplacian row (only zero-area faces around m): no term.
                 continue;
             }
-            let scale = l_im / mass;
+            let scale = length2 * l_im / mass;
             scratch.add(m, scale * ops.diagonal[m as usize]);
             for &(j, l_mj) in ops.off_diagonal.row(m as usize) {
                 scratch.add(j, scale * l_mj);

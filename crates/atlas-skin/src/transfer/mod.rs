@@ -19,8 +19,9 @@
 //!    the source's, so that a small hat and a long coat are judged alike), θ = 30° by
 //!    default.
 //! 2. **Inpainting** (§3.2, [`inpaint`]): the other vertices' weights minimise
-//!    tr(Wᵀ Q W), Q = −L + L M⁻¹ L (cotangent Laplacian L, Voronoi mass M:
-//!    [`cotangent`]), with the matched rows fixed: Q_uu W_u = −Q_uk W_k, solved by a
+//!    tr(Wᵀ Q W), Q = −L + D² L M⁻¹ L (cotangent Laplacian L, Voronoi mass M:
+//!    [`cotangent`]; D the source's bounding-box diagonal, so that the energy does not
+//!    depend on the file's units), with the matched rows fixed: Q_uu W_u = −Q_uk W_k, solved by a
 //!    sparse Cholesky factorisation (faer). Each connected piece of the target is solved
 //!    on its own. Negative weights (the energy does not bound them) are dropped and the
 //!    rows rescaled to sum to 1.
@@ -349,6 +350,7 @@ pub fn transfer_weights(
         } else if matched_count < vertices.len() {
             inpaint_piece(
                 &operators,
+                source_size,
                 vertices,
                 &matched,
                 &mut rows,
@@ -421,10 +423,12 @@ pub fn transfer_weights(
     })
 }
 
-/// Inpaints the unmatched vertices of one piece (§3.2) into `rows`; `slot` and
-/// `local_rows` are #V scratch, left as found (`FIXED`, empty).
+/// Inpaints the unmatched vertices of one piece (§3.2) into `rows`, with the energy's
+/// `length` D ([`System::length`]); `slot` and `local_rows` are #V scratch, left as found
+/// (`FIXED`, empty).
 fn inpaint_piece(
     operators: &Operators,
+    length: f64,
     vertices: &[u32],
     matched: &[bool],
     rows: &mut [Vec<(u32, f64)>],
@@ -459,6 +463,7 @@ fn inpaint_piece(
         unknown: &unknown,
         slot,
         columns: joints.len(),
+        length,
     };
     let solution = system.solve(&|j| local_rows[j].as_slice());
     for &v in vertices {
