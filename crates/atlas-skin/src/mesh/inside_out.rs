@@ -1,10 +1,11 @@
 //! Inside-out pieces: closed connected components whose faces are wound inward (negative
-//! signed volume V = Σ a · (b × c) / 6 over the piece's triangles; Zhang & Chen 2001), next
+//! signed volume V = Σ (a − o) · ((b − o) × (c − o)) / 6 over the piece's triangles, o
+//! the mesh's centre, [`SurfaceMesh::signed_volume`]; Zhang & Chen 2001), next
 //! to a surface wound outward. The method reads a single orientation for the whole
 //! surface (the ray test of joint roles), so such a piece would read as inside out; it is
 //! turned outward before the method runs. Open pieces have no inside and stay as they are.
 
-use super::surface::SurfaceMesh;
+use super::surface::{cone_volume, SurfaceMesh};
 use super::topology::Topology;
 use crate::tolerance::NEGLIGIBLE;
 
@@ -18,9 +19,12 @@ pub fn turn_inside_out_pieces(mesh: &mut SurfaceMesh, topology: &mut Topology) -
     let (component, count) = (&topology.vertex_component, topology.component_count);
     let mut volume = vec![0.0; count];
     let mut closed = vec![true; count];
+    // About the mesh's centre, as `SurfaceMesh::signed_volume`: a closed piece's volume
+    // does not depend on it, the whole mesh's (open pieces too) moves with the mesh.
+    let centre = mesh.centre();
     for t in &mesh.triangles {
-        let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
-        volume[component[t[0] as usize] as usize] += a.dot(b.cross(c)) / 6.0;
+        let corners = t.map(|v| mesh.positions[v as usize]);
+        volume[component[t[0] as usize] as usize] += cone_volume(corners, centre);
     }
     for (e, edge) in topology.edges.iter().enumerate() {
         if topology.faces_of_edge(e).len() != 2 {

@@ -51,15 +51,25 @@ impl SurfaceMesh {
         (b - a).cross(c - a)
     }
 
-    /// Signed enclosed volume V = Σ_f a·(b × c) / 6 over the triangles' corners a, b, c:
-    /// positive for a closed outward-oriented surface (divergence theorem).
+    /// Centre of the bounding box: the point [`Self::signed_volume`] is taken about.
+    pub fn centre(&self) -> DVec3 {
+        let (lo, hi) = self.bounding_box();
+        0.5 * (lo + hi)
+    }
+
+    /// Signed volume V = Σ_f (a − o)·((b − o) × (c − o)) / 6 over the triangles' corners
+    /// a, b, c, about the bounding box's centre o: the enclosed volume, positive, for a
+    /// closed outward-oriented surface (divergence theorem), whatever o. On an open
+    /// surface (a character of separate open pieces, a garment) the sum depends on o, the
+    /// apex of the cones it adds up: taken about the origin, the same file moved by two of
+    /// its diagonals could change sign and read as inside out; taken about its own centre
+    /// it moves with the mesh and is positive when most of the surface faces away from its
+    /// middle.
     pub fn signed_volume(&self) -> f64 {
+        let o = self.centre();
         self.triangles
             .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|v| self.positions[v as usize]);
-                a.dot(b.cross(c)) / 6.0
-            })
+            .map(|t| cone_volume(t.map(|v| self.positions[v as usize]), o))
             .sum()
     }
 
@@ -81,4 +91,10 @@ impl SurfaceMesh {
     pub fn triangle_area(&self, f: usize) -> f64 {
         0.5 * self.scaled_normal(f).length()
     }
+}
+
+/// Signed volume of the tetrahedron from apex `o` over triangle `[a, b, c]`:
+/// (a − o)·((b − o) × (c − o)) / 6.
+pub fn cone_volume([a, b, c]: [DVec3; 3], o: DVec3) -> f64 {
+    (a - o).dot((b - o).cross(c - o)) / 6.0
 }
