@@ -1,6 +1,6 @@
-//! Inside-out pieces: closed connected components whose faces are wound inward (negative
-//! signed volume V = Σ (a − o) · ((b − o) × (c − o)) / 6 over the piece's triangles, o
-//! the mesh's centre, [`SurfaceMesh::signed_volume`]; Zhang & Chen 2001), next
+//! Inside-out pieces: closed connected components whose faces are wound consistently and
+//! inward (negative signed volume V = Σ (a − o) · ((b − o) × (c − o)) / 6 over the
+//! piece's triangles, the same for any point o; Zhang & Chen 2001), next
 //! to a surface wound outward. The method reads a single orientation for the whole
 //! surface (the ray test of joint roles), so such a piece would read as inside out; it is
 //! turned outward before the method runs. Open pieces have no inside and stay as they are.
@@ -10,30 +10,39 @@ use super::topology::Topology;
 use crate::tolerance::NEGLIGIBLE;
 
 /// Turns every closed component of negative signed volume outward (each of its triangles
-/// [a, b, c] becomes [a, c, b]) when the mesh as a whole has positive signed volume, and
+/// [a, b, c] becomes [a, c, b]) when the mesh as a whole has positive signed volume
+/// ([`SurfaceMesh::signed_volume`], about its centre), and
 /// returns how many components were turned. `topology` is `mesh`'s and stays so: a turned
 /// face's edges 0 and 2 exchange (edge i joins corners i and i + 1), and nothing else of a
 /// topology depends on the winding (its edges, their faces and the vertices' rows are
 /// ordered by vertex and face index).
 pub fn turn_inside_out_pieces(mesh: &mut SurfaceMesh, topology: &mut Topology) -> usize {
     let (component, count) = (&topology.vertex_component, topology.component_count);
-    let mut volume = vec![0.0; count];
-    let mut closed = vec![true; count];
-    // About the mesh's centre, as `SurfaceMesh::signed_volume`: a closed piece's volume
-    // does not depend on it, the whole mesh's (open pieces too) moves with the mesh.
-    let centre = mesh.centre();
-    for t in &mesh.triangles {
-        let corners = t.map(|v| mesh.positions[v as usize]);
-        volume[component[t[0] as usize] as usize] += cone_volume(corners, centre);
+    let negligible = NEGLIGIBLE * mesh.diagonal().powi(3);
+    if mesh.signed_volume() <= negligible {
+        return 0;
     }
+    // A piece is judged when it is closed and wound one way: every edge has two faces
+    // that run along it in opposite directions. Its volume is then the same about any
+    // point (here the mesh's centre). A piece closed by its edges but wound both ways has
+    // no inside that a turn of all its faces would restore; it is left as it is.
+    let mut closed = vec![true; count];
     for (e, edge) in topology.edges.iter().enumerate() {
-        if topology.faces_of_edge(e).len() != 2 {
+        let consistent = match topology.faces_of_edge(e) {
+            &[f, g] => {
+                runs_forward(mesh, topology, f, e, edge) != runs_forward(mesh, topology, g, e, edge)
+            }
+            _ => false,
+        };
+        if !consistent {
             closed[component[edge[0] as usize] as usize] = false;
         }
     }
-    let negligible = NEGLIGIBLE * mesh.diagonal().powi(3);
-    if volume.iter().sum::<f64>() <= negligible {
-        return 0;
+    let centre = mesh.centre();
+    let mut volume = vec![0.0; count];
+    for t in &mesh.triangles {
+        let corners = t.map(|v| mesh.positions[v as usize]);
+        volume[component[t[0] as usize] as usize] += cone_volume(corners, centre);
     }
     let inward: Vec<bool> = (0..count)
         .map(|k| closed[k] && volume[k] < -negligible)
@@ -47,27 +56,33 @@ pub fn turn_inside_out_pieces(mesh: &mut SurfaceMesh, topology: &mut Topology) -
     inward.iter().filter(|&&i| i).count()
 }
 
+/// Whether face `f` runs along its edge `e` = `edge` (ascending ends) from `edge[0]` to
+/// `edge[1]`: its edge i joins its corners i and i + 1.
+fn runs_forward(
+    mesh: &SurfaceMesh,
+    topology: &Topology,
+    f: u32,
+    e: usize,
+    edge: &[u32; 2],
+) -> bool {
+    let t = mesh.triangles[f as usize];
+    let i = topology.face_edges[f as usize]
+        .iter()
+        .position(|&fe| fe as usize == e)
+        .expect("a face of the edge");
+    t[i] == edge[0] && t[(i + 1) % 3] == edge[1]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::fixtures::shapes::icosphere;
     use glam::DVec3;
 
-    /// A big outward sphere and a small one wound inward beside it: the small one is
-    /// turned, the big one kept, and the topology is that of the turned mesh; a mesh that
-    /// is inward as a whole is left alone.
-    #[test]
-    fn closed_inward_pieces_beside_an_outward_body_are_turned() {
-        let body = icosphere(1.0, 2);
-        let mut piece = icosphere(0.2, 1);
-        for p in &mut piece.positions {
-            *p += DVec3::new(3.0, 0.0, 0.0);
-        }
-        for t in &mut piece.triangles {
-            t.swap(1, 2);
-        }
+    /// `body` and `piece` in one mesh.
+    fn joined(body: &SurfaceMesh, piece: &SurfaceMesh) -> SurfaceMesh {
         let offset = body.positions.len() as u32;
-        let mut mesh = SurfaceMesh {
+        SurfaceMesh {
             positions: body
                 .positions
                 .iter()
@@ -80,7 +95,29 @@ mod tests {
                 .copied()
                 .chain(piece.triangles.iter().map(|t| t.map(|v| v + offset)))
                 .collect(),
-        };
+        }
+    }
+
+    /// A sphere of radius `radius` centred at `centre`, wound inward.
+    fn inward_sphere(radius: f64, centre: DVec3) -> SurfaceMesh {
+        let mut sphere = icosphere(radius, 1);
+        for p in &mut sphere.positions {
+            *p += centre;
+        }
+        for t in &mut sphere.triangles {
+            t.swap(1, 2);
+        }
+        sphere
+    }
+
+    /// A big outward sphere and a small one wound inward beside it: the small one is
+    /// turned, the big one kept, and the topology is that of the turned mesh; a mesh that
+    /// is inward as a whole is left alone.
+    #[test]
+    fn closed_inward_pieces_beside_an_outward_body_are_turned() {
+        let body = icosphere(1.0, 2);
+        let piece = inward_sphere(0.2, DVec3::new(3.0, 0.0, 0.0));
+        let mut mesh = joined(&body, &piece);
         let mut topology = Topology::new(&mesh);
         assert_eq!(turn_inside_out_pieces(&mut mesh, &mut topology), 1);
         assert_eq!(topology, Topology::new(&mesh));
@@ -94,5 +131,44 @@ mod tests {
         }
         let mut topology = Topology::new(&inward);
         assert_eq!(turn_inside_out_pieces(&mut inward, &mut topology), 0);
+    }
+
+    /// The same body and piece anywhere: the piece is turned wherever they stand. A piece
+    /// closed by its edges but wound both ways (half its faces turned) is left as it is.
+    #[test]
+    fn the_decision_does_not_depend_on_where_the_mesh_stands() {
+        for shift in [
+            DVec3::ZERO,
+            DVec3::new(0.0, 0.0, 50.0),
+            DVec3::new(-7.0, 20.0, 3.0),
+        ] {
+            let mut body = icosphere(1.0, 2);
+            for p in &mut body.positions {
+                *p += shift;
+            }
+            let piece = inward_sphere(0.2, DVec3::new(3.0, 0.0, 0.0) + shift);
+            let mut mesh = joined(&body, &piece);
+            let mut topology = Topology::new(&mesh);
+            assert_eq!(
+                turn_inside_out_pieces(&mut mesh, &mut topology),
+                1,
+                "{shift}"
+            );
+
+            let mut mixed = piece.clone();
+            let half = mixed.triangles.len() / 2;
+            for t in &mut mixed.triangles[..half] {
+                t.swap(1, 2);
+            }
+            let mut mesh = joined(&body, &mixed);
+            let before = mesh.triangles.clone();
+            let mut topology = Topology::new(&mesh);
+            assert_eq!(
+                turn_inside_out_pieces(&mut mesh, &mut topology),
+                0,
+                "{shift}"
+            );
+            assert_eq!(mesh.triangles, before);
+        }
     }
 }
