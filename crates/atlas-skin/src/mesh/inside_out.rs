@@ -26,15 +26,21 @@ pub fn turn_inside_out_pieces(mesh: &mut SurfaceMesh, topology: &mut Topology) -
     // that run along it in opposite directions. Its volume is then the same about any
     // point (here the mesh's centre). A piece closed by its edges but wound both ways has
     // no inside that a turn of all its faces would restore; it is left as it is.
+    // Per edge: its faces running along it from its lower end (+1) and from its upper
+    // end (−1); face f's edge i joins its corners i and i + 1.
+    let mut direction = vec![0i32; topology.edges.len()];
+    for (t, edges) in mesh.triangles.iter().zip(&topology.face_edges) {
+        for (i, &e) in edges.iter().enumerate() {
+            direction[e as usize] += if t[i] == topology.edges[e as usize][0] {
+                1
+            } else {
+                -1
+            };
+        }
+    }
     let mut closed = vec![true; count];
     for (e, edge) in topology.edges.iter().enumerate() {
-        let consistent = match topology.faces_of_edge(e) {
-            &[f, g] => {
-                runs_forward(mesh, topology, f, e, edge) != runs_forward(mesh, topology, g, e, edge)
-            }
-            _ => false,
-        };
-        if !consistent {
+        if topology.faces_of_edge(e).len() != 2 || direction[e] != 0 {
             closed[component[edge[0] as usize] as usize] = false;
         }
     }
@@ -54,23 +60,6 @@ pub fn turn_inside_out_pieces(mesh: &mut SurfaceMesh, topology: &mut Topology) -
         }
     }
     inward.iter().filter(|&&i| i).count()
-}
-
-/// Whether face `f` runs along its edge `e` = `edge` (ascending ends) from `edge[0]` to
-/// `edge[1]`: its edge i joins its corners i and i + 1.
-fn runs_forward(
-    mesh: &SurfaceMesh,
-    topology: &Topology,
-    f: u32,
-    e: usize,
-    edge: &[u32; 2],
-) -> bool {
-    let t = mesh.triangles[f as usize];
-    let i = topology.face_edges[f as usize]
-        .iter()
-        .position(|&fe| fe as usize == e)
-        .expect("a face of the edge");
-    t[i] == edge[0] && t[(i + 1) % 3] == edge[1]
 }
 
 #[cfg(test)]

@@ -21,8 +21,8 @@
 //! 2. **Inpainting** (§3.2, [`inpaint`]): the other vertices' weights minimise
 //!    tr(Wᵀ Q W), Q = −L + D² L M⁻¹ L (cotangent Laplacian L, Voronoi mass M:
 //!    [`cotangent`]; D the source's bounding-box diagonal, so that the energy does not
-//!    depend on the file's units), with the matched rows fixed: Q_uu W_u = −Q_uk W_k, solved by a
-//!    sparse Cholesky factorisation (faer). Each connected piece of the target is solved
+//!    depend on the file's units), with the matched rows fixed: Q_uu W_u = −Q_uk W_k,
+//!    solved by a sparse Cholesky factorisation (faer). Each connected piece of the target is solved
 //!    on its own. Negative weights (the energy does not bound them) are dropped and the
 //!    rows rescaled to sum to 1.
 //! 3. **A piece with no matched vertex** (a button floating over a coat, a prop held away
